@@ -1,0 +1,94 @@
+/* gs_event.h - what the core reports. Unknown values are NaN (emitted as null). */
+#ifndef GS_EVENT_H
+#define GS_EVENT_H
+
+#include "gs_types.h"
+
+typedef enum {
+    GS_EV_START = 0, /* written by the program that owns the source (it knows the fps) */
+    GS_EV_JUMP,      /* one flight, accepted or rejected */
+    GS_EV_HEIGHT,    /* running aggregate after each accepted flight */
+    GS_EV_SUMMARY,   /* end of stream: the run's final answer */
+    GS_EV_STATE,     /* trace: state machine change */
+    GS_EV_SAMPLE,    /* trace: one COM sample */
+    GS_EV_FIT        /* trace: one fit attempt (window and result) */
+} gs_event_type;
+
+typedef enum {
+    GS_REJ_NONE = 0,
+    GS_REJ_FEW_SAMPLES,     /* "few_samples" */
+    GS_REJ_LARGE_RESIDUAL,  /* "large_residual" */
+    GS_REJ_IMPLAUSIBLE_A,   /* "implausible_acceleration" */
+    GS_REJ_NO_SIZE,         /* "no_size": no standing pixel size known around the flight */
+    GS_REJ_UNCERTAIN_A,     /* "uncertain_acceleration": relative SE of a too large */
+    GS_REJ_GAP              /* "gap": frames missing inside the flight */
+} gs_reject_reason;
+
+/* warning bits of a jump */
+#define GS_WARN_FEW_SAMPLES   0x01u /* "few_samples": accepted but short */
+#define GS_WARN_GRAVITY_TILT  0x02u /* "gravity_tilt": fitted gravity direction far from the body axis / previous flights */
+#define GS_WARN_SIZE_CHANGED  0x04u /* "size_changed": standing size before and after differ */
+#define GS_WARN_OUTLIERS      0x08u /* "outliers": many samples rejected by the robust fit */
+#define GS_WARN_CLIPPED       0x10u /* "edge_truncated": flight window cut by a gap or the stream's end */
+
+const char *gs_reject_reason_name(gs_reject_reason r);
+
+typedef struct {
+    const char *version;
+    const char *config;       /* config file name or "default" */
+    double fps_source;        /* NaN unknown */
+    const char *fps_origin;   /* "timestamps", "container", "metadata", "cli", ... or NULL */
+    const char *layout;       /* layout name or NULL */
+} gs_ev_start;
+
+typedef struct {
+    uint32_t track;           /* 0 unless several objects are tracked */
+    uint32_t index;           /* 0-based flight counter of the run */
+    double t_takeoff_s, t_land_s, flight_time_s, t_apex_s;
+    double a_px_s2, a_px_se_s2, g_dir_deg, q_m_per_px;
+    double size_px;           /* pixel size used (standing stature, ball diameter) */
+    double height_m, height_se_m;
+    double jump_height_m, takeoff_velocity_m_s;
+    uint32_t n_samples, n_outliers;
+    double rms_px;
+    bool accepted;
+    gs_reject_reason reason;
+    uint32_t warnings;        /* GS_WARN_* bits */
+} gs_ev_jump;
+
+typedef struct {
+    uint32_t track;
+    double height_m, ci95_lo_m, ci95_hi_m;
+    uint32_t n_jumps, n_rejected;
+} gs_ev_height;  /* also the summary */
+
+typedef struct {
+    double t_s;
+    const char *from, *to;
+} gs_ev_state;
+
+typedef struct {
+    double t_s;
+    float x_px, y_px, w, size_px, upright;
+} gs_ev_sample;
+
+typedef struct {
+    double t_first_s, t_last_s;
+    uint32_t n;
+    double a_px_s2, g_dir_deg, rms_px;
+    const char *purpose;      /* e.g. "flight", "extend", "final" */
+} gs_ev_fit;
+
+typedef struct {
+    gs_event_type type;
+    union {
+        gs_ev_start start;
+        gs_ev_jump jump;
+        gs_ev_height height;   /* GS_EV_HEIGHT and GS_EV_SUMMARY */
+        gs_ev_state state;
+        gs_ev_sample sample;
+        gs_ev_fit fit;
+    } u;
+} gs_event;
+
+#endif

@@ -1,0 +1,56 @@
+/* gs_fit.h - streaming weighted least-squares fit of x(t) and y(t) to quadratics,
+ * by Givens-rotation updates of a 3x3 triangular factor in centred, scaled time
+ * tau = (t - t0) / tscale (no t^4 sums), plus a robust refit over a ring window. */
+#ifndef GS_FIT_H
+#define GS_FIT_H
+
+#include "gs_types.h"
+#include "gs_ring.h"
+
+typedef struct {
+    double t0_s, tscale_s;
+    double r[6];          /* upper triangle of R, row-major: r00 r01 r02 r11 r12 r22 */
+    double zx[3], zy[3];  /* Q^T * sqrt(w) * x and y */
+    double ssr_x, ssr_y;  /* weighted residual sum of squares */
+    double sum_w;
+    uint32_t n;           /* samples with w > 0 */
+} gs_fit;
+
+typedef struct {
+    double t0_s;              /* reference time of the coefficients */
+    double x0_px, vx_px_s, ax_px_s2;  /* x(t) = x0 + vx*(t-t0) + ax/2*(t-t0)^2 */
+    double y0_px, vy_px_s, ay_px_s2;
+    double a_px_s2;           /* |(ax, ay)| */
+    double a_se_px_s2;        /* standard error of a_px_s2 */
+    double g_dir_deg;         /* direction of (ax, ay) from image down (+y), positive toward +x */
+    double rms_px;            /* weighted RMS of the 2D residual */
+    uint32_t n;
+} gs_fit_result;
+
+/* Start an empty fit. t0_s: a time inside the expected window (e.g. the first
+ * sample); tscale_s > 0: about the window's length. */
+void gs_fit_init(gs_fit *f, double t0_s, double tscale_s);
+/* Add one sample with weight w >= 0 (w == 0 or non-finite values are ignored). */
+void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w);
+/* Solve. GS_EINVAL when fewer than 4 weighted samples or the design is singular. */
+gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out);
+
+typedef enum {
+    GS_FIT_IRLS = 0,  /* Tukey-biweight iteratively reweighted LS on the 2D residual: default */
+    GS_FIT_RANSAC,    /* the paper's: RANSAC (deterministic PRNG) then LS on inliers */
+    GS_FIT_PLAIN      /* weighted LS once */
+} gs_fit_method;
+
+const char *gs_fit_method_name(gs_fit_method m);
+bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out);
+
+/* Robust fit of the ring samples [first, first+count) using each sample's w as
+ * prior weight. scratch_w: caller memory for `count` floats; on return holds
+ * each sample's final weight (0 = rejected as outlier). min_scale_px: floor for
+ * the residual scale (keeps perfect data from rejecting everything).
+ * Returns GS_EINVAL when a sample is missing from the ring or < 4 remain. */
+gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count,
+                        gs_fit_method method, float min_scale_px,
+                        float *scratch_w, gs_fit_result *out);
+
+#endif

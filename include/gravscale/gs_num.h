@@ -1,0 +1,29 @@
+/* gs_num.h - number parsing and formatting without libc's strtod/printf
+ * (newlib's allocate on a microcontroller). */
+#ifndef GS_NUM_H
+#define GS_NUM_H
+
+#include "gs_types.h"
+
+/* Parse exactly s[0..len) as a decimal number: optional sign, digits, optional
+ * '.' and digits, optional exponent (e/E, sign, digits). No spaces, no hex, no
+ * "nan"/"inf". Returns false (out untouched) on any syntax error or when the
+ * value overflows a double. Result within 1 ulp of the correctly rounded value
+ * for up to 19 significant digits. */
+bool gs_num_parse(const char *s, size_t len, double *out);
+
+/* Parse exactly s[0..len) as a base-10 integer (optional sign). */
+bool gs_num_parse_int(const char *s, size_t len, long *out);
+
+/* Format a finite v with exactly `decimals` (0..9) digits after the point,
+ * rounded half away from zero, "-0.000" printed as "0.000". Writes a NUL.
+ * Returns chars written (without the NUL), or 0 when v is not finite, |v| >= 1e15,
+ * or cap is too small (buf then holds ""). */
+size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals);
+
+/* Format a finite v with `sig` (1..15) significant digits, in plain notation
+ * when 1e-4 <= |v| < 1e15, otherwise as d.ddde-XX; trailing zeros trimmed.
+ * The text is a valid JSON number. Same return convention as above. */
+size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig);
+
+#endif

@@ -1,0 +1,45 @@
+/* gs_pipeline.h - the whole core: keypoints -> COM sample -> ring -> flight
+ * detection and fit -> height aggregate -> events. Caller owns all memory. */
+#ifndef GS_PIPELINE_H
+#define GS_PIPELINE_H
+
+#include "gs_types.h"
+#include "gs_com.h"
+#include "gs_ring.h"
+#include "gs_flight.h"
+#include "gs_agg.h"
+#include "gs_config.h"
+
+typedef struct {
+    gs_core_config cfg;
+    gs_layout layout;
+    gs_ring ring;
+    gs_flight flight;
+    gs_agg agg;
+    gs_event_fn on_event;
+    void *ctx;
+    double last_t_s;
+    uint64_t n_frames;
+    bool finished;
+} gs_pipeline;
+
+/* Bytes of storage gs_pipeline_init needs for cfg->ring_capacity. */
+size_t gs_pipeline_storage_bytes(const gs_core_config *cfg);
+
+/* storage: at least gs_pipeline_storage_bytes(cfg) bytes, aligned for double. */
+gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout layout,
+                           void *storage, size_t storage_bytes,
+                           gs_event_fn on_event, void *ctx);
+/* Also emit GS_EV_STATE / GS_EV_SAMPLE / GS_EV_FIT trace events. */
+void gs_pipeline_set_trace(gs_pipeline *p, bool on);
+
+/* One frame of keypoints (gs_layout_kp_count(layout) of them). t_s must not
+ * decrease (GS_EORDER, sample dropped); equal times are dropped silently. */
+gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp);
+/* One frame of a tracked point (GS_LAYOUT_POINT) with its size (NaN unknown). */
+gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px,
+                                 float c, float size_px);
+/* End of stream: finish open flights and emit GS_EV_SUMMARY. Further pushes: GS_ESTATE. */
+gs_status gs_pipeline_flush(gs_pipeline *p);
+
+#endif

@@ -1,0 +1,52 @@
+/* gs_types.h - status codes, keypoints and the per-frame COM sample shared by every core module. */
+#ifndef GS_TYPES_H
+#define GS_TYPES_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define GS_VERSION "0.1.0"
+
+typedef enum {
+    GS_OK = 0,
+    GS_EINVAL,   /* bad argument or value */
+    GS_ERANGE,   /* value outside its allowed range */
+    GS_ENOMEM,   /* caller storage or buffer too small */
+    GS_ESYNTAX,  /* malformed text */
+    GS_ENOKEY,   /* unknown key or section */
+    GS_EORDER,   /* time went backwards */
+    GS_ESTATE    /* call not allowed in the current state */
+} gs_status;
+
+const char *gs_status_str(gs_status s);
+
+/* One detected keypoint in pixels (y down); c = confidence 0..1, c == 0 means missing. */
+typedef struct {
+    float x_px;
+    float y_px;
+    float c;
+} gs_kp;
+
+typedef enum {
+    GS_LAYOUT_POINT = 0,  /* one tracked point (ball centre): 1 keypoint */
+    GS_LAYOUT_COCO17,     /* COCO-17 order: nose, l/r eye, l/r ear, l/r shoulder, l/r elbow, l/r wrist, l/r hip, l/r knee, l/r ankle */
+    GS_LAYOUT_BLAZEPOSE33 /* BlazePose-33 order (heels 29/30, foot index 31/32) */
+} gs_layout;
+
+/* A per-frame sample as kept in the ring: the COM (or object centre) and the
+ * object's pixel size this frame (stature in px when upright, ball diameter);
+ * NaN where unknown. */
+typedef struct {
+    double t_s;      /* source timestamp, seconds */
+    float x_px;      /* COM x */
+    float y_px;      /* COM y (down) */
+    float w;         /* weight 0..1 (0 = unusable frame) */
+    float size_px;   /* object size in px this frame, NaN unknown */
+    float up_x;      /* unit vector of the body axis feet->head in the image, NaN unknown */
+    float up_y;
+    float upright;   /* 0..1 how upright/straight the body stands (1 for rigid objects), NaN unknown */
+    float reserved;
+} gs_sample;
+
+#endif

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Set up a fresh Debian 12 machine and build gravscale, then run the main job on
+# the bundled sample. Safe to run again: it only installs what is missing.
+#   tools/bootstrap.sh            (BUILD_DIR=build by default)
+set -euo pipefail
+top=$(cd "$(dirname "$0")/.." && pwd)
+cd "$top"
+BUILD_DIR=${BUILD_DIR:-build}
+
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+
+pkgs=(build-essential cmake ninja-build python3 binutils)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "bootstrap: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+bash tools/fetch_unity.sh
+
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+cmake --build "$BUILD_DIR" -j "$(nproc)"
+
+echo "bootstrap: main job on the bundled sample (tests/data/sample_jumps.csv):"
+"$BUILD_DIR/gravscale" replay --keypoints tests/data/sample_jumps.csv | tee "$BUILD_DIR/sample_out.jsonl" | tail -n 2
+python3 - "$BUILD_DIR/sample_out.jsonl" <<'PY'
+import json, sys
+last = [json.loads(l) for l in open(sys.argv[1])][-1]
+assert last["event"] == "summary", last
+h = last["height_m"]
+print("bootstrap: height from the sample: %s m over %d jumps (95%% interval %s)" % (
+    "%.3f" % h if h is not None else "unknown", last["n_jumps"], last["ci95_m"]))
+PY
