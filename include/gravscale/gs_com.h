@@ -35,6 +35,23 @@ typedef struct {
 gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_method stature,
                          float min_conf, const gs_kp *kp, gs_com_out *out);
 
+/* Body segments of the mass model; limbs count one side. */
+typedef enum {
+    GS_SEG_HEAD = 0,  /* head and neck */
+    GS_SEG_TRUNK,
+    GS_SEG_UPPER_ARM,
+    GS_SEG_FOREARM,
+    GS_SEG_HAND,
+    GS_SEG_THIGH,
+    GS_SEG_SHANK,
+    GS_SEG_FOOT,
+    GS_SEG_COUNT
+} gs_segment;
+
+/* Mass fraction of one segment (one side for limbs) in a table, normalised so
+ * head + trunk + 2 x (limb segments) = 1; NaN for a bad table or segment. */
+float gs_mass_fraction(gs_mass_table t, gs_segment s);
+
 /* Name <-> enum for config and logs ("deleva", "clauser", "dempster";
  * "anthro", "nose_ankle_1.17"; "point", "coco17", "blazepose33"). */
 const char *gs_mass_table_name(gs_mass_table t);

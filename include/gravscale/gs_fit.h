@@ -32,7 +32,9 @@ typedef struct {
 void gs_fit_init(gs_fit *f, double t0_s, double tscale_s);
 /* Add one sample with weight w >= 0 (w == 0 or non-finite values are ignored). */
 void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w);
-/* Solve. GS_EINVAL when fewer than 4 weighted samples or the design is singular. */
+/* Solve. GS_EINVAL when fewer than 3 weighted samples or the design is singular
+ * (e.g. fewer than 3 distinct times). With exactly 3 the exact parabola is
+ * returned and a_se_px_s2 is NaN (no degrees of freedom). */
 gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out);
 
 typedef enum {
@@ -48,7 +50,8 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out);
  * prior weight. scratch_w: caller memory for `count` floats; on return holds
  * each sample's final weight (0 = rejected as outlier). min_scale_px: floor for
  * the residual scale (keeps perfect data from rejecting everything).
- * Returns GS_EINVAL when a sample is missing from the ring or < 4 remain. */
+ * Returns GS_EINVAL when a sample is missing from the ring or < 3 remain
+ * (with 3 the SE is NaN, as in gs_fit_solve). */
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count,
                         gs_fit_method method, float min_scale_px,
                         float *scratch_w, gs_fit_result *out);

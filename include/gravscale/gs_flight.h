@@ -29,30 +29,54 @@ typedef struct {
     gs_event_fn on_event;
     void *ctx;
     bool trace;
+    bool rigid;                /* object size is measured in every frame (ball), not while standing */
     double g_m_s2;
 
     gs_flight_state state;
-    uint64_t cand_first;       /* absolute index of the first sample of the open candidate */
-    uint64_t last_seen;        /* next ring index to examine */
-    uint64_t quiet_from;       /* index after the last reported flight's landing */
+    uint64_t next;             /* next ring index to examine */
+    uint64_t quiet_from;       /* first index after the last closed candidate */
+    double last_t_s;           /* time of the last valid sample, NaN none */
+    uint64_t last_idx;
 
-    /* adaptive levels, in the "up" coordinate along -gravity */
-    double up_x, up_y;         /* current estimate of the image up direction (unit) */
-    bool up_from_flight;       /* estimated from a fitted flight (else body axis / image) */
-    double ground_u;           /* adaptive ground (standing) level of the COM along up */
-    double noise_px;           /* adaptive COM noise level */
-    double size_px_ref;        /* typical object size (for thresholds) */
+    double up_x, up_y;         /* image direction against gravity (unit) */
+    uint32_t up_n;             /* body-axis samples averaged into it */
+    bool up_from_flight;       /* set from fitted flights (else body axis or image up) */
+
+    double noise_px;           /* robust COM noise (1 axis), from ground phases; NaN until known */
+    float noise_init[9];       /* first |second differences| (NOISE_INIT_N) */
+    uint32_t noise_n;
+    double u_hist[3];          /* last three u of valid samples (for a median of 3) */
+    uint64_t i_hist[3];
+    double t_hist[3];
+    uint32_t n_hist;
+
+    double blk_min_cur, blk_min_prev; /* running minimum of u over the last ~0.5-1 s */
+    double blk_t0;
+    double peak_u;             /* running maximum once the rise is significant */
+    uint64_t peak_idx;
+    double peak_t;
+
+    /* the open flight candidate */
+    gs_fit fit;                /* streaming fit of the accepted in-flight samples */
+    uint64_t fl_first, fl_last;   /* accepted range so far (absolute ring indices) */
+    uint64_t seed_idx;
+    double cusum;              /* one-sided CUSUM of the deviation against gravity */
+    uint32_t outliers_run;     /* consecutive gross outliers */
+    double dt_med_s;           /* typical frame interval */
 
     float stand_size[GS_STAND_KEEP];
-    double stand_t[GS_STAND_KEEP];
     uint32_t stand_n, stand_next;
+    double stand_last_t;
+    double still_since;        /* start of the current still, upright stretch, NaN none */
+    double lag_t, lag_u;       /* u at least 0.1 s back, for a jitter-proof speed */
 
     double last_a_px_s2;       /* last accepted acceleration, NaN none */
+    double last_g_dir_deg;
     uint32_t n_flights;
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
-                         float *scratch_w, gs_event_fn on_event, void *ctx);
+                         float *scratch_w, bool rigid, gs_event_fn on_event, void *ctx);
 /* Examine every sample pushed to the ring since the last call. Emits GS_EV_JUMP
  * events through on_event (and trace events when f->trace). */
 void gs_flight_update(gs_flight *f);

@@ -1,0 +1,49 @@
+/* main.c - the gravscale program: dispatch to a subcommand. */
+#include <stdio.h>
+#include <string.h>
+
+#include "gravscale/gs_types.h"
+
+/* Defined in cmd_replay.c (no app header yet: one prototype per side). */
+int gs_cmd_replay(int argc, char **argv);
+
+static void usage(FILE *f)
+{
+    fputs("usage: gravscale COMMAND [OPTIONS]\n"
+          "\n"
+          "Measure a person's or an object's metric size from an uncalibrated static\n"
+          "camera, using gravity as the ruler during free flight.\n"
+          "\n"
+          "commands:\n"
+          "  replay     read recorded keypoints (CSV, AlphaPose, OpenPose) and report\n"
+          "             jumps and the height as JSON Lines or NMEA sentences\n"
+          "\n"
+          "options:\n"
+          "  --help     this text\n"
+          "  --version  print the version\n"
+          "\n"
+          "gravscale COMMAND --help describes a command. Exit codes: 0 ok, 1 bad input\n"
+          "data, 2 usage or config error, 3 I/O error writing output.\n",
+          f);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
+        usage(stdout);
+        return fflush(stdout) == 0 ? 0 : 3;
+    }
+    if (strcmp(cmd, "--version") == 0) {
+        fputs("gravscale " GS_VERSION "\n", stdout);
+        return fflush(stdout) == 0 ? 0 : 3;
+    }
+    if (strcmp(cmd, "replay") == 0)
+        return gs_cmd_replay(argc - 1, argv + 1);
+    fprintf(stderr, "gravscale: unknown command '%s' (see gravscale --help)\n", cmd);
+    return 2;
+}

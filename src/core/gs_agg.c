@@ -1,0 +1,173 @@
+/* gs_agg.c - robust running aggregate of per-flight sizes: the median of the
+ * newest GS_AGG_MAX accepted flights and a 95 % interval that stays honest
+ * from one flight to many. See docs/anthropometry.md ("Aggregate") for the
+ * derivation and the Monte Carlo check in tests/test_agg.c. */
+#include <math.h>
+
+#include "gravscale/gs_agg.h"
+
+/* With one flight the between-flight scatter cannot be seen; a per-flight
+ * relative scatter (pose, size and outlier flights the fit's SE misses) is
+ * assumed instead: 3 % of the value, 5 cm at 1.75 m. */
+#define SINGLE_FLIGHT_REL_SPREAD 0.03
+
+#define MAD_TO_SIGMA 1.4826 /* 1 / Phi^-1(0.75) */
+#define MEDIAN_SE_FACTOR 1.2533 /* sqrt(pi/2): SE(median) / SE(mean), large n, normal data */
+
+/* Small-sample correction of the MAD (Croux & Rousseeuw 1992), n = 2..9;
+ * n / (n - 0.8) beyond. Values from memory of their table. */
+static const double k_mad_corr[10] = { 0, 0, 1.196, 1.495, 1.363, 1.206, 1.200, 1.140, 1.129, 1.107 };
+
+/* SE(median) / (sigma / sqrt(n)) for normal data and small n: the median of 2
+ * is the mean; exact small-n ratios up to 5, the large-n value beyond. */
+static const double k_median_se[6] = { 1.0, 1.0, 1.0, 1.160, 1.092, 1.197 };
+
+/* Student-t 97.5 % quantiles by degrees of freedom. */
+static const struct {
+    double dof, q;
+} k_t975[] = {
+    { 1, 12.706 }, { 2, 4.303 }, { 3, 3.182 }, { 4, 2.776 }, { 5, 2.571 }, { 6, 2.447 },
+    { 7, 2.365 }, { 8, 2.306 }, { 9, 2.262 }, { 10, 2.228 }, { 12, 2.179 }, { 15, 2.131 },
+    { 20, 2.086 }, { 30, 2.042 }, { 40, 2.021 }, { 60, 2.000 }, { 120, 1.980 },
+};
+#define N_T975 (sizeof k_t975 / sizeof k_t975[0])
+
+/* t quantile for a real dof >= 1, linear in 1/dof between table rows (exact
+ * at the rows, 1.96 at infinity). */
+static double t975(double dof)
+{
+    if (!(dof > 1.0)) {
+        return k_t975[0].q;
+    }
+    for (size_t i = 1; i < N_T975; i++) {
+        if (dof <= k_t975[i].dof) {
+            double a = 1.0 / k_t975[i - 1].dof, b = 1.0 / k_t975[i].dof, x = 1.0 / dof;
+            return k_t975[i - 1].q + (k_t975[i].q - k_t975[i - 1].q) * (a - x) / (a - b);
+        }
+    }
+    double b = 1.0 / k_t975[N_T975 - 1].dof;
+    return 1.96 + (k_t975[N_T975 - 1].q - 1.96) * (1.0 / dof) / b;
+}
+
+static void sort_asc(double *v, uint32_t n)
+{
+    for (uint32_t i = 1; i < n; i++) {
+        double x = v[i];
+        uint32_t j = i;
+        while (j > 0 && v[j - 1] > x) {
+            v[j] = v[j - 1];
+            j--;
+        }
+        v[j] = x;
+    }
+}
+
+static double median_sorted(const double *v, uint32_t n)
+{
+    return (n & 1u) ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void gs_agg_init(gs_agg *a)
+{
+    if (!a) {
+        return;
+    }
+    for (uint32_t i = 0; i < GS_AGG_MAX; i++) {
+        a->value[i] = NAN;
+        a->se[i] = NAN;
+    }
+    a->held = a->next = 0;
+    a->n_accepted = a->n_rejected = 0;
+}
+
+void gs_agg_add(gs_agg *a, double value_m, double se_m)
+{
+    if (!a) {
+        return;
+    }
+    /* A flight without a usable size was a flight that failed: count it as rejected. */
+    if (!isfinite(value_m) || !(value_m > 0.0)) {
+        a->n_rejected++;
+        return;
+    }
+    a->value[a->next] = (float)value_m;
+    a->se[a->next] = (isfinite(se_m) && se_m >= 0.0) ? (float)se_m : NAN; /* unknown SE kept as NaN */
+    a->next = (a->next + 1u) % GS_AGG_MAX;
+    if (a->held < GS_AGG_MAX) {
+        a->held++;
+    }
+    a->n_accepted++;
+}
+
+void gs_agg_reject(gs_agg *a)
+{
+    if (a) {
+        a->n_rejected++;
+    }
+}
+
+void gs_agg_get(const gs_agg *a, gs_ev_height *out)
+{
+    if (!out) {
+        return;
+    }
+    out->height_m = out->ci95_lo_m = out->ci95_hi_m = NAN;
+    out->n_jumps = 0;
+    out->n_rejected = 0;
+    if (!a) {
+        return;
+    }
+    out->n_jumps = a->n_accepted;
+    out->n_rejected = a->n_rejected;
+    uint32_t n = a->held > GS_AGG_MAX ? GS_AGG_MAX : a->held;
+    if (n == 0) {
+        return;
+    }
+
+    double v[GS_AGG_MAX], dev[GS_AGG_MAX];
+    double se2_sum = 0.0;
+    uint32_t n_se = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        v[i] = a->value[i];
+        if (!isnan(a->se[i])) {
+            se2_sum += (double)a->se[i] * (double)a->se[i];
+            n_se++;
+        }
+    }
+    sort_asc(v, n);
+    double med = median_sorted(v, n);
+    out->height_m = med;
+    double rms_se = n_se > 0 ? sqrt(se2_sum / n_se) : (double)NAN;
+
+    double half;
+    if (n == 1) {
+        double tau = SINGLE_FLIGHT_REL_SPREAD * med;
+        double se = isnan(rms_se) ? 0.0 : rms_se;
+        half = 1.96 * sqrt(se * se + tau * tau);
+    } else {
+        /* Between-flight spread: MAD, scaled to a normal sigma, small-sample corrected. */
+        for (uint32_t i = 0; i < n; i++) {
+            dev[i] = fabs(v[i] - med);
+        }
+        sort_asc(dev, n);
+        double corr = n < 10 ? k_mad_corr[n] : (double)n / ((double)n - 0.8);
+        double spread = MAD_TO_SIGMA * median_sorted(dev, n) * corr;
+        /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
+        double se_floor = isnan(rms_se) ? 0.0 : rms_se;
+        double sigma = spread > se_floor ? spread : se_floor;
+        /* Satterthwaite: only the part of sigma^2 beyond the known SEs is estimated
+         * from the n flights (n-1 dof); all of it known -> normal quantile. */
+        double excess2 = spread * spread - se_floor * se_floor;
+        double q = 1.96;
+        if (excess2 > 0.0) {
+            double s4 = sigma * sigma * sigma * sigma;
+            q = t975((double)(n - 1u) * s4 / (excess2 * excess2));
+        }
+        double k = n < 6 ? k_median_se[n] : MEDIAN_SE_FACTOR;
+        half = q * k * sigma / sqrt((double)n);
+    }
+    if (isfinite(half)) {
+        out->ci95_lo_m = med - half;
+        out->ci95_hi_m = med + half;
+    }
+}

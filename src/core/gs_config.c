@@ -1,0 +1,441 @@
+/* gs_config.c - "[section]" / "key = value" text parsed in place (no heap, no
+ * copies), each key routed to its section's handler; the [core] handler. */
+#include "gravscale/gs_config.h"
+#include "gravscale/gs_num.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#define CFG_MAX_LINE 255u
+
+/* ------------------------------------------------------------- utilities */
+
+/* copy s[0..n) into dst[cap] always NUL-terminated (truncating) */
+static void copy_text(char *dst, size_t cap, const char *s, size_t n)
+{
+    if (!dst || cap == 0) return;
+    if (n >= cap) n = cap - 1u;
+    if (n) memcpy(dst, s, n);
+    dst[n] = '\0';
+}
+
+static void copy_cstr(char *dst, size_t cap, const char *s) { copy_text(dst, cap, s, s ? strlen(s) : 0u); }
+
+/* append a C string to the NUL-terminated dst[cap] */
+static void append(char *dst, size_t cap, const char *s)
+{
+    size_t n = strlen(dst);
+    if (n < cap) copy_text(dst + n, cap - n, s, strlen(s));
+}
+
+static bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+static bool key_char_ok(char c)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.' ||
+           c == '-';
+}
+
+static bool same(const char *a, size_t an, const char *b, size_t bn) { return an == bn && memcmp(a, b, an) == 0; }
+
+static bool is_lit(const char *s, size_t n, const char *lit) { return same(s, n, lit, strlen(lit)); }
+
+/* ------------------------------------------------------------ line lexer */
+
+typedef enum { LN_EMPTY, LN_SECTION, LN_KEY, LN_ERROR } ln_kind;
+
+typedef struct {
+    ln_kind kind;
+    const char *a; /* section name or key */
+    size_t an;
+    const char *b; /* value */
+    size_t bn;
+    const char *err; /* LN_ERROR: why */
+} ln_tok;
+
+static void trim(const char **s, size_t *n)
+{
+    while (*n && is_blank(**s)) {
+        (*s)++;
+        (*n)--;
+    }
+    while (*n && is_blank((*s)[*n - 1u])) (*n)--;
+}
+
+/* One line without its line ending. */
+static ln_tok lex_line(const char *s, size_t n)
+{
+    ln_tok t = {LN_EMPTY, NULL, 0, NULL, 0, NULL};
+    trim(&s, &n);
+    if (n == 0 || s[0] == '#' || s[0] == ';') return t;
+    if (s[0] == '[') {
+        size_t rb = 1;
+        while (rb < n && s[rb] != ']') rb++;
+        if (rb == n) {
+            t.kind = LN_ERROR;
+            t.err = "section header without ']'";
+            return t;
+        }
+        /* after ']' only blanks or a comment */
+        for (size_t i = rb + 1u; i < n; i++) {
+            if (s[i] == '#' || s[i] == ';') break;
+            if (!is_blank(s[i])) {
+                t.kind = LN_ERROR;
+                t.err = "text after section header";
+                return t;
+            }
+        }
+        t.a = s + 1;
+        t.an = rb - 1u;
+        trim(&t.a, &t.an);
+        if (t.an == 0) {
+            t.kind = LN_ERROR;
+            t.err = "empty section name";
+            return t;
+        }
+        t.kind = LN_SECTION;
+        return t;
+    }
+    size_t eq = 0;
+    while (eq < n && s[eq] != '=') eq++;
+    if (eq == n) {
+        t.kind = LN_ERROR;
+        t.err = "expected 'key = value'";
+        return t;
+    }
+    t.a = s;
+    t.an = eq;
+    trim(&t.a, &t.an);
+    t.kind = LN_KEY;
+    if (t.an == 0) {
+        t.kind = LN_ERROR;
+        t.err = "empty key";
+        return t;
+    }
+    for (size_t i = 0; i < t.an; i++) {
+        if (!key_char_ok(t.a[i])) {
+            t.kind = LN_ERROR;
+            t.err = "bad character in key";
+            return t;
+        }
+    }
+    t.b = s + eq + 1u;
+    t.bn = n - eq - 1u;
+    /* an inline comment starts at # or ; preceded by a blank */
+    for (size_t i = 1; i < t.bn; i++) {
+        if ((t.b[i] == '#' || t.b[i] == ';') && is_blank(t.b[i - 1u])) {
+            t.bn = i;
+            break;
+        }
+    }
+    trim(&t.b, &t.bn);
+    return t;
+}
+
+/* next line of text[pos..len): [*ls, *le) without CR/LF; returns the next pos */
+static size_t next_line(const char *text, size_t len, size_t pos, size_t *ls, size_t *le)
+{
+    size_t e = pos;
+    while (e < len && text[e] != '\n') e++;
+    *ls = pos;
+    *le = (e > pos && text[e - 1u] == '\r') ? e - 1u : e;
+    return e < len ? e + 1u : e;
+}
+
+/* Was key already set in a section of this name before offset `upto`?
+ * Rescanning keeps the parser free of per-key storage; config files are small. */
+static bool seen_before(const char *text, size_t upto, const char *sec, size_t secn, const char *key, size_t keyn)
+{
+    const char *cur = NULL;
+    size_t curn = 0;
+    size_t pos = 0;
+    while (pos < upto) {
+        size_t ls, le;
+        pos = next_line(text, upto, pos, &ls, &le);
+        ln_tok t = lex_line(text + ls, le - ls);
+        if (t.kind == LN_SECTION) {
+            cur = t.a;
+            curn = t.an;
+        } else if (t.kind == LN_KEY && cur && same(cur, curn, sec, secn) && same(t.a, t.an, key, keyn)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static gs_status fail(gs_cfg_error *err, gs_status st, uint32_t line, const char *sec, size_t secn,
+                      const char *key, size_t keyn, const char *msg)
+{
+    err->line = line;
+    copy_text(err->section, sizeof err->section, sec ? sec : "", sec ? secn : 0u);
+    copy_text(err->key, sizeof err->key, key ? key : "", key ? keyn : 0u);
+    if (msg) copy_cstr(err->msg, sizeof err->msg, msg);
+    return st;
+}
+
+gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *sections, size_t n_sections,
+                       gs_cfg_error *err)
+{
+    gs_cfg_error dummy;
+    if (!err) err = &dummy;
+    memset(err, 0, sizeof *err);
+    if (!text && len) return fail(err, GS_EINVAL, 0, NULL, 0, NULL, 0, "no text");
+    const gs_cfg_section *cur = NULL;
+    const char *cur_name = NULL;
+    size_t cur_n = 0;
+    uint32_t line = 0;
+    size_t pos = 0;
+    while (pos < len) {
+        size_t ls, le;
+        size_t next = next_line(text, len, pos, &ls, &le);
+        line++;
+        if (memchr(text + ls, '\0', le - ls) || (le < len && text[le] == '\0'))
+            return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, "NUL byte in text");
+        if (le - ls > CFG_MAX_LINE)
+            return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, "line longer than 255 characters");
+        ln_tok t = lex_line(text + ls, le - ls);
+        if (t.kind == LN_ERROR) return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, t.err);
+        if (t.kind == LN_SECTION) {
+            cur = NULL;
+            for (size_t i = 0; sections && i < n_sections; i++) {
+                if (sections[i].name && is_lit(t.a, t.an, sections[i].name)) {
+                    cur = &sections[i];
+                    break;
+                }
+            }
+            if (!cur) return fail(err, GS_ENOKEY, line, t.a, t.an, NULL, 0, "unknown section");
+            cur_name = t.a;
+            cur_n = t.an;
+        } else if (t.kind == LN_KEY) {
+            if (!cur) return fail(err, GS_ESYNTAX, line, NULL, 0, t.a, t.an, "key before any [section]");
+            if (seen_before(text, ls, cur_name, cur_n, t.a, t.an))
+                return fail(err, GS_EINVAL, line, cur_name, cur_n, t.a, t.an, "duplicate key");
+            err->msg[0] = '\0';
+            gs_status st = cur->fn ? cur->fn(cur->ctx, t.a, t.an, t.b, t.bn, err->msg, sizeof err->msg)
+                                   : GS_ENOKEY;
+            if (st != GS_OK) {
+                const char *why = err->msg[0] ? NULL
+                                  : st == GS_ENOKEY ? "unknown key"
+                                  : st == GS_ERANGE ? "value out of range"
+                                                    : "bad value";
+                return fail(err, st, line, cur_name, cur_n, t.a, t.an, why);
+            }
+        }
+        pos = next;
+    }
+    err->msg[0] = '\0'; /* a handler may have left text on success */
+    return GS_OK;
+}
+
+/* ------------------------------------------------------------------ [core] */
+
+typedef enum { T_DBL, T_DBL_AUTO, T_FLT, T_U32, T_U32_POW2 } num_type;
+
+typedef struct {
+    const char *key;
+    num_type type;
+    double lo, hi;
+    size_t off;
+} num_key;
+
+/* every numeric [core] key with its range (docs/config.md lists the same) */
+static const num_key k_num_keys[] = {
+    {"g_m_s2", T_DBL_AUTO, 9.7, 9.9, offsetof(gs_core_config, g_m_s2)},
+    {"latitude_deg", T_DBL_AUTO, -90.0, 90.0, offsetof(gs_core_config, latitude_deg)},
+    {"altitude_m", T_DBL, -500.0, 9000.0, offsetof(gs_core_config, altitude_m)},
+    {"min_conf", T_FLT, 0.0, 1.0, offsetof(gs_core_config, min_conf)},
+    {"ring_capacity", T_U32_POW2, 64.0, 65536.0, offsetof(gs_core_config, ring_capacity)},
+    {"min_flight_s", T_FLT, 0.05, 2.0, offsetof(gs_core_config, min_flight_s)},
+    {"max_flight_s", T_FLT, 0.1, 5.0, offsetof(gs_core_config, max_flight_s)},
+    {"min_samples", T_U32, 4.0, 1000.0, offsetof(gs_core_config, min_samples)},
+    {"max_rms_rel", T_FLT, 0.001, 1.0, offsetof(gs_core_config, max_rms_rel)},
+    {"max_a_se_rel", T_FLT, 0.001, 1.0, offsetof(gs_core_config, max_a_se_rel)},
+    {"size_min_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_min_m)},
+    {"size_max_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_max_m)},
+    {"max_gap_s", T_FLT, 0.01, 2.0, offsetof(gs_core_config, max_gap_s)},
+    {"landing_latency_s", T_FLT, 0.02, 1.0, offsetof(gs_core_config, landing_latency_s)},
+};
+
+void gs_core_config_default(gs_core_config *c)
+{
+    if (!c) return;
+    memset(c, 0, sizeof *c);
+    c->g_m_s2 = NAN;
+    c->latitude_deg = NAN;
+    c->altitude_m = 0.0;
+    c->mass_table = GS_MASS_DELEVA;
+    c->stature = GS_STATURE_ANTHRO;
+    c->min_conf = 0.3f;
+    c->fit_method = GS_FIT_IRLS;
+    c->ring_capacity = 512u;
+    c->min_flight_s = 0.12f;
+    c->max_flight_s = 1.5f;
+    c->min_samples = 6u;
+    c->max_rms_rel = 0.03f;
+    c->max_a_se_rel = 0.15f;
+    c->size_min_m = 0.3f;
+    c->size_max_m = 2.6f;
+    c->max_gap_s = 0.2f;
+    c->landing_latency_s = 0.2f;
+    c->format = GS_FMT_JSON;
+}
+
+static void range_msg(char *msg, size_t cap, const num_key *k)
+{
+    char lo[32], hi[32];
+    gs_num_fmt_sig(lo, sizeof lo, k->lo, 6);
+    gs_num_fmt_sig(hi, sizeof hi, k->hi, 6);
+    copy_cstr(msg, cap, k->type == T_U32_POW2 ? "must be a power of two in " : "must be within ");
+    append(msg, cap, lo);
+    append(msg, cap, "..");
+    append(msg, cap, hi);
+}
+
+static bool is_pow2(uint32_t v) { return v && !(v & (v - 1u)); }
+
+static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, size_t n, char *msg, size_t cap)
+{
+    unsigned char *base = (unsigned char *)c;
+    if (k->type == T_U32 || k->type == T_U32_POW2) {
+        long x;
+        if (!gs_num_parse_int(v, n, &x)) {
+            copy_cstr(msg, cap, "not an integer");
+            return GS_EINVAL;
+        }
+        if ((double)x < k->lo || (double)x > k->hi || (k->type == T_U32_POW2 && !is_pow2((uint32_t)x))) {
+            range_msg(msg, cap, k);
+            return GS_ERANGE;
+        }
+        uint32_t u = (uint32_t)x;
+        memcpy(base + k->off, &u, sizeof u);
+        return GS_OK;
+    }
+    double x;
+    if (k->type == T_DBL_AUTO && is_lit(v, n, "auto")) {
+        x = NAN; /* explicit "unset" */
+    } else {
+        if (!gs_num_parse(v, n, &x)) {
+            copy_cstr(msg, cap, k->type == T_DBL_AUTO ? "not a number (or auto)" : "not a number");
+            return GS_EINVAL;
+        }
+        if (!(x >= k->lo && x <= k->hi)) {
+            range_msg(msg, cap, k);
+            return GS_ERANGE;
+        }
+    }
+    if (k->type == T_FLT) {
+        float f = (float)x;
+        memcpy(base + k->off, &f, sizeof f);
+    } else {
+        memcpy(base + k->off, &x, sizeof x);
+    }
+    return GS_OK;
+}
+
+gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len, const char *value, size_t value_len,
+                             char *msg, size_t cap)
+{
+    gs_core_config *c = (gs_core_config *)ctx;
+    if (!c || !key || (!value && value_len)) return GS_EINVAL;
+    if (!value) value = "";
+    trim(&value, &value_len);
+    for (size_t i = 0; i < sizeof k_num_keys / sizeof k_num_keys[0]; i++)
+        if (is_lit(key, key_len, k_num_keys[i].key)) return set_num(c, &k_num_keys[i], value, value_len, msg, cap);
+    if (is_lit(key, key_len, "mass_table")) {
+        if (gs_mass_table_from_name(value, value_len, &c->mass_table)) return GS_OK;
+        copy_cstr(msg, cap, "expected deleva, clauser or dempster");
+        return GS_EINVAL;
+    }
+    if (is_lit(key, key_len, "stature")) {
+        if (gs_stature_method_from_name(value, value_len, &c->stature)) return GS_OK;
+        copy_cstr(msg, cap, "expected anthro or nose_ankle_1.17");
+        return GS_EINVAL;
+    }
+    if (is_lit(key, key_len, "fit")) {
+        if (gs_fit_method_from_name(value, value_len, &c->fit_method)) return GS_OK;
+        copy_cstr(msg, cap, "expected irls, ransac or plain");
+        return GS_EINVAL;
+    }
+    if (is_lit(key, key_len, "format")) {
+        if (gs_format_from_name(value, value_len, &c->format)) return GS_OK;
+        copy_cstr(msg, cap, "expected json or nmea");
+        return GS_EINVAL;
+    }
+    copy_cstr(msg, cap, "unknown key");
+    return GS_ENOKEY;
+}
+
+static gs_status check_fail(gs_cfg_error *err, gs_status st, const char *key, const char *msg)
+{
+    if (err) {
+        memset(err, 0, sizeof *err);
+        copy_cstr(err->section, sizeof err->section, "core");
+        copy_cstr(err->key, sizeof err->key, key);
+        copy_cstr(err->msg, sizeof err->msg, msg);
+    }
+    return st;
+}
+
+gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
+{
+    if (err) memset(err, 0, sizeof *err);
+    if (!c) return check_fail(err, GS_EINVAL, "", "no config");
+    /* a config filled in by code gets the same range checks as a parsed one */
+    const unsigned char *base = (const unsigned char *)c;
+    for (size_t i = 0; i < sizeof k_num_keys / sizeof k_num_keys[0]; i++) {
+        const num_key *k = &k_num_keys[i];
+        double x;
+        bool ok;
+        if (k->type == T_U32 || k->type == T_U32_POW2) {
+            uint32_t u;
+            memcpy(&u, base + k->off, sizeof u);
+            x = (double)u;
+            ok = x >= k->lo && x <= k->hi && (k->type != T_U32_POW2 || is_pow2(u));
+        } else if (k->type == T_FLT) {
+            float f;
+            memcpy(&f, base + k->off, sizeof f);
+            x = (double)f;
+            /* a float holds the decimal bound only approximately */
+            ok = x >= (double)(float)k->lo && x <= (double)(float)k->hi;
+        } else {
+            memcpy(&x, base + k->off, sizeof x);
+            ok = (k->type == T_DBL_AUTO && isnan(x)) || (x >= k->lo && x <= k->hi);
+        }
+        if (!ok) {
+            char msg[64];
+            range_msg(msg, sizeof msg, k);
+            return check_fail(err, GS_ERANGE, k->key, msg);
+        }
+    }
+    if ((unsigned)c->mass_table > (unsigned)GS_MASS_DEMPSTER)
+        return check_fail(err, GS_EINVAL, "mass_table", "unknown mass table");
+    if ((unsigned)c->stature > (unsigned)GS_STATURE_NOSE_ANKLE_117)
+        return check_fail(err, GS_EINVAL, "stature", "unknown stature method");
+    if ((unsigned)c->fit_method > (unsigned)GS_FIT_PLAIN)
+        return check_fail(err, GS_EINVAL, "fit", "unknown fit method");
+    if ((unsigned)c->format > (unsigned)GS_FMT_NMEA) return check_fail(err, GS_EINVAL, "format", "unknown format");
+    if (!(c->min_flight_s < c->max_flight_s))
+        return check_fail(err, GS_ERANGE, "max_flight_s", "max_flight_s must exceed min_flight_s");
+    if (!(c->size_min_m < c->size_max_m))
+        return check_fail(err, GS_ERANGE, "size_max_m", "size_max_m must exceed size_min_m");
+    return GS_OK;
+}
+
+double gs_gravity_m_s2(double latitude_deg, double altitude_m)
+{
+    /* WGS-84 normal gravity on the ellipsoid (Somigliana), then the free-air gradient */
+    const double pi = 3.14159265358979323846;
+    double s = sin(latitude_deg * (pi / 180.0));
+    double s2 = s * s;
+    double g0 = 9.7803253359 * (1.0 + 0.00193185265241 * s2) / sqrt(1.0 - 0.00669437999013 * s2);
+    return g0 - 3.086e-6 * altitude_m;
+}
+
+double gs_core_config_g(const gs_core_config *c)
+{
+    if (!c) return 9.81;
+    if (isfinite(c->g_m_s2)) return c->g_m_s2;
+    if (isfinite(c->latitude_deg)) return gs_gravity_m_s2(c->latitude_deg, isfinite(c->altitude_m) ? c->altitude_m : 0.0);
+    return 9.81;
+}

@@ -1,0 +1,344 @@
+/* gs_emit.c - events as JSON Lines or NMEA 0183-style sentences in a caller
+ * buffer; all or nothing, never past cap. Field layout: docs/protocol.md. */
+#include "gravscale/gs_emit.h"
+#include "gravscale/gs_num.h"
+
+#include <math.h>
+#include <string.h>
+
+/* NMEA 0183 caps a sentence at 82 characters including "$" and CR LF. */
+#define NMEA_MAX 82u
+
+typedef struct {
+    char *buf;
+    size_t cap;
+    size_t len;
+    bool ok;
+} gs_w;
+
+static void w_raw(gs_w *w, const char *s, size_t n)
+{
+    /* keep one byte for the NUL */
+    if (!w->ok || w->len + n + 1u > w->cap) {
+        w->ok = false;
+        return;
+    }
+    memcpy(w->buf + w->len, s, n);
+    w->len += n;
+}
+
+static void w_lit(gs_w *w, const char *s) { w_raw(w, s, strlen(s)); }
+
+static void w_u32(gs_w *w, uint32_t v)
+{
+    char t[12];
+    size_t n = sizeof t;
+    do {
+        t[--n] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v);
+    w_raw(w, t + n, sizeof t - n);
+}
+
+/* a JSON string; NULL -> null. Control bytes become \u00XX; other bytes pass (UTF-8 stays UTF-8). */
+static void w_jstr(gs_w *w, const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    if (!s) {
+        w_lit(w, "null");
+        return;
+    }
+    w_raw(w, "\"", 1);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') {
+            char e[2] = {'\\', (char)c};
+            w_raw(w, e, 2);
+        } else if (c < 0x20u) {
+            char e[6] = {'\\', 'u', '0', '0', hex[c >> 4], hex[c & 15u]};
+            w_raw(w, e, 6);
+        } else {
+            w_raw(w, (const char *)&c, 1);
+        }
+    }
+    w_raw(w, "\"", 1);
+}
+
+static void w_fixed(gs_w *w, double v, int decimals)
+{
+    char t[40];
+    size_t n = gs_num_fmt_fixed(t, sizeof t, v, decimals);
+    if (n) w_raw(w, t, n);
+    else w_lit(w, "null"); /* NaN, inf, or beyond 1e15 */
+}
+
+static void w_sig(gs_w *w, double v, int sig)
+{
+    char t[40];
+    size_t n = gs_num_fmt_sig(t, sizeof t, v, sig);
+    if (n) w_raw(w, t, n);
+    else w_lit(w, "null");
+}
+
+static size_t w_finish(gs_w *w)
+{
+    if (!w->ok) {
+        if (w->buf && w->cap) w->buf[0] = '\0';
+        return 0;
+    }
+    w->buf[w->len] = '\0';
+    return w->len;
+}
+
+/* names of the GS_WARN_* bits, in bit order (protocol names) */
+static const char *const k_warn_names[] = {"few_samples", "gravity_tilt", "size_changed", "outliers",
+                                           "edge_truncated"};
+
+static void json_jump(gs_w *w, const gs_ev_jump *j)
+{
+    w_lit(w, "{\"event\":\"jump\",\"track\":");
+    w_u32(w, j->track);
+    w_lit(w, ",\"index\":");
+    w_u32(w, j->index);
+    w_lit(w, ",\"t_takeoff_s\":");
+    w_fixed(w, j->t_takeoff_s, 4);
+    w_lit(w, ",\"t_land_s\":");
+    w_fixed(w, j->t_land_s, 4);
+    w_lit(w, ",\"flight_time_s\":");
+    w_fixed(w, j->flight_time_s, 4);
+    w_lit(w, ",\"t_apex_s\":");
+    w_fixed(w, j->t_apex_s, 4);
+    w_lit(w, ",\"a_px_s2\":");
+    w_sig(w, j->a_px_s2, 6);
+    w_lit(w, ",\"a_px_se_s2\":");
+    w_sig(w, j->a_px_se_s2, 6);
+    w_lit(w, ",\"g_dir_deg\":");
+    w_fixed(w, j->g_dir_deg, 2);
+    w_lit(w, ",\"q_m_per_px\":");
+    w_sig(w, j->q_m_per_px, 6);
+    w_lit(w, ",\"size_px\":");
+    w_fixed(w, j->size_px, 2);
+    w_lit(w, ",\"height_m\":");
+    w_fixed(w, j->height_m, 4);
+    w_lit(w, ",\"height_se_m\":");
+    w_fixed(w, j->height_se_m, 4);
+    w_lit(w, ",\"jump_height_m\":");
+    w_fixed(w, j->jump_height_m, 4);
+    w_lit(w, ",\"takeoff_velocity_m_s\":");
+    w_fixed(w, j->takeoff_velocity_m_s, 3);
+    w_lit(w, ",\"n_samples\":");
+    w_u32(w, j->n_samples);
+    w_lit(w, ",\"n_outliers\":");
+    w_u32(w, j->n_outliers);
+    w_lit(w, ",\"rms_px\":");
+    w_fixed(w, j->rms_px, 3);
+    w_lit(w, j->accepted ? ",\"accepted\":true,\"reason\":" : ",\"accepted\":false,\"reason\":");
+    w_jstr(w, j->accepted ? NULL : gs_reject_reason_name(j->reason));
+    w_lit(w, ",\"warnings\":[");
+    bool first = true;
+    for (uint32_t b = 0; b < sizeof k_warn_names / sizeof k_warn_names[0]; b++) {
+        if (!(j->warnings & (1u << b))) continue;
+        if (!first) w_raw(w, ",", 1);
+        w_jstr(w, k_warn_names[b]);
+        first = false;
+    }
+    w_lit(w, "]}\n");
+}
+
+static void json_height(gs_w *w, const gs_ev_height *h, bool summary)
+{
+    w_lit(w, summary ? "{\"event\":\"summary\",\"track\":" : "{\"event\":\"height\",\"track\":");
+    w_u32(w, h->track);
+    w_lit(w, ",\"height_m\":");
+    w_fixed(w, h->height_m, 4);
+    w_lit(w, ",\"ci95_m\":");
+    /* an interval with an unknown end is no interval */
+    if (isfinite(h->ci95_lo_m) && isfinite(h->ci95_hi_m) && isfinite(h->height_m)) {
+        w_raw(w, "[", 1);
+        w_fixed(w, h->ci95_lo_m, 4);
+        w_raw(w, ",", 1);
+        w_fixed(w, h->ci95_hi_m, 4);
+        w_raw(w, "]", 1);
+    } else {
+        w_lit(w, "null");
+    }
+    w_lit(w, ",\"n_jumps\":");
+    w_u32(w, h->n_jumps);
+    w_lit(w, ",\"n_rejected\":");
+    w_u32(w, h->n_rejected);
+    w_lit(w, "}\n");
+}
+
+size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
+{
+    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
+    if (!w.ok) return w_finish(&w);
+    switch (ev->type) {
+    case GS_EV_START: {
+        const gs_ev_start *s = &ev->u.start;
+        w_lit(&w, "{\"event\":\"start\",\"version\":");
+        w_jstr(&w, s->version ? s->version : GS_VERSION);
+        w_lit(&w, ",\"config\":");
+        w_jstr(&w, s->config);
+        w_lit(&w, ",\"fps_source\":");
+        w_sig(&w, s->fps_source, 6);
+        w_lit(&w, ",\"fps_origin\":");
+        w_jstr(&w, s->fps_origin);
+        w_lit(&w, ",\"layout\":");
+        w_jstr(&w, s->layout);
+        w_lit(&w, "}\n");
+        break;
+    }
+    case GS_EV_JUMP: json_jump(&w, &ev->u.jump); break;
+    case GS_EV_HEIGHT: json_height(&w, &ev->u.height, false); break;
+    case GS_EV_SUMMARY: json_height(&w, &ev->u.height, true); break;
+    case GS_EV_STATE: {
+        const gs_ev_state *s = &ev->u.state;
+        w_lit(&w, "{\"event\":\"state\",\"t_s\":");
+        w_fixed(&w, s->t_s, 4);
+        w_lit(&w, ",\"from\":");
+        w_jstr(&w, s->from);
+        w_lit(&w, ",\"to\":");
+        w_jstr(&w, s->to);
+        w_lit(&w, "}\n");
+        break;
+    }
+    case GS_EV_SAMPLE: {
+        const gs_ev_sample *s = &ev->u.sample;
+        w_lit(&w, "{\"event\":\"sample\",\"t_s\":");
+        w_fixed(&w, s->t_s, 4);
+        w_lit(&w, ",\"x_px\":");
+        w_fixed(&w, (double)s->x_px, 2);
+        w_lit(&w, ",\"y_px\":");
+        w_fixed(&w, (double)s->y_px, 2);
+        w_lit(&w, ",\"w\":");
+        w_fixed(&w, (double)s->w, 3);
+        w_lit(&w, ",\"size_px\":");
+        w_fixed(&w, (double)s->size_px, 2);
+        w_lit(&w, ",\"upright\":");
+        w_fixed(&w, (double)s->upright, 3);
+        w_lit(&w, "}\n");
+        break;
+    }
+    case GS_EV_FIT: {
+        const gs_ev_fit *f = &ev->u.fit;
+        w_lit(&w, "{\"event\":\"fit\",\"purpose\":");
+        w_jstr(&w, f->purpose);
+        w_lit(&w, ",\"t_first_s\":");
+        w_fixed(&w, f->t_first_s, 4);
+        w_lit(&w, ",\"t_last_s\":");
+        w_fixed(&w, f->t_last_s, 4);
+        w_lit(&w, ",\"n\":");
+        w_u32(&w, f->n);
+        w_lit(&w, ",\"a_px_s2\":");
+        w_sig(&w, f->a_px_s2, 6);
+        w_lit(&w, ",\"g_dir_deg\":");
+        w_fixed(&w, f->g_dir_deg, 2);
+        w_lit(&w, ",\"rms_px\":");
+        w_fixed(&w, f->rms_px, 3);
+        w_lit(&w, "}\n");
+        break;
+    }
+    default: w.ok = false; break;
+    }
+    return w_finish(&w);
+}
+
+/* ------------------------------------------------------------------ NMEA */
+
+/* A number in at most `width` characters: `decimals` decimals, fewer when the
+ * value is large, empty when it is unknown or cannot fit (keeps <= 82 chars). */
+static void n_num(gs_w *w, double v, int decimals, size_t width)
+{
+    w_raw(w, ",", 1);
+    if (!isfinite(v)) return;
+    for (int d = decimals; d >= 0; d--) {
+        char t[40];
+        size_t n = gs_num_fmt_fixed(t, sizeof t, v, d);
+        if (n && n <= width) {
+            w_raw(w, t, n);
+            return;
+        }
+    }
+}
+
+static void n_u32(gs_w *w, uint32_t v)
+{
+    w_raw(w, ",", 1);
+    w_u32(w, v);
+}
+
+/* NMEA text fields may not hold the delimiters $ * , ! \ ^ ~ or non-printables */
+static void n_text(gs_w *w, const char *s, size_t max_len)
+{
+    w_raw(w, ",", 1);
+    for (size_t i = 0; s && s[i] && i < max_len; i++) {
+        char c = s[i];
+        if (c < 0x20 || c > 0x7e || strchr("$*,!\\^~", c)) c = '_';
+        w_raw(w, &c, 1);
+    }
+}
+
+size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
+{
+    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
+    if (!w.ok) return w_finish(&w);
+    switch (ev->type) {
+    case GS_EV_JUMP: {
+        /* widths: 10+5+8+9+6+5+6+10+1+1 = 61 = 82 - "$GSJMP" - 10 commas - "*HH\r\n" */
+        const gs_ev_jump *j = &ev->u.jump;
+        w_lit(&w, "$GSJMP");
+        n_num(&w, j->t_takeoff_s, 3, 10);
+        n_num(&w, j->flight_time_s, 3, 5);
+        n_num(&w, j->a_px_s2, 1, 8);
+        n_num(&w, j->q_m_per_px, 7, 9);
+        n_num(&w, j->height_m, 3, 6);
+        n_num(&w, j->jump_height_m, 3, 5);
+        n_num(&w, j->takeoff_velocity_m_s, 2, 6);
+        n_u32(&w, j->n_samples);
+        w_lit(&w, j->accepted ? ",A" : ",R");
+        w_raw(&w, ",", 1);
+        if ((uint32_t)j->reason <= 9u) {
+            char c = (char)('0' + (int)j->reason);
+            w_raw(&w, &c, 1);
+        }
+        break;
+    }
+    case GS_EV_HEIGHT:
+    case GS_EV_SUMMARY: {
+        const gs_ev_height *h = &ev->u.height;
+        w_lit(&w, ev->type == GS_EV_HEIGHT ? "$GSHGT" : "$GSSUM");
+        n_num(&w, h->height_m, 4, 12);
+        n_num(&w, h->ci95_lo_m, 4, 12);
+        n_num(&w, h->ci95_hi_m, 4, 12);
+        n_u32(&w, h->n_jumps);
+        if (ev->type == GS_EV_SUMMARY) n_u32(&w, h->n_rejected);
+        break;
+    }
+    case GS_EV_START:
+        w_lit(&w, "$GSSTA");
+        n_text(&w, ev->u.start.version ? ev->u.start.version : GS_VERSION, 20);
+        n_num(&w, ev->u.start.fps_source, 3, 10);
+        break;
+    default: w.ok = false; break; /* trace events have no sentence */
+    }
+    if (w.ok) {
+        static const char hex[] = "0123456789ABCDEF";
+        unsigned char x = 0;
+        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
+        char tail[5] = {'*', hex[x >> 4], hex[x & 15u], '\r', '\n'};
+        w_raw(&w, tail, sizeof tail);
+        if (w.len > NMEA_MAX) w.ok = false; /* cannot happen with the widths above */
+    }
+    return w_finish(&w);
+}
+
+size_t gs_emit(gs_format fmt, const gs_event *ev, char *buf, size_t cap)
+{
+    switch (fmt) {
+    case GS_FMT_JSON: return gs_emit_json(ev, buf, cap);
+    case GS_FMT_NMEA: return gs_emit_nmea(ev, buf, cap);
+    }
+    if (buf && cap) buf[0] = '\0';
+    return 0;
+}

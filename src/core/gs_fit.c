@@ -1,0 +1,612 @@
+/* gs_fit.c - streaming weighted quadratic fit by Givens rotations, and robust
+ * (IRLS / RANSAC / plain) refits over a window of ring samples. */
+#include "gravscale/gs_fit.h"
+
+#include <math.h>
+
+/* A diagonal of R below this fraction of its column's norm means the column is
+ * (numerically) a combination of the previous ones: the design is singular. */
+#define GS_FIT_SINGULAR_REL 1e-9
+
+/* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
+#define GS_FIT_TUKEY_C 4.685
+/* Consistency factor that turns a median absolute residual into a Gaussian SD. */
+#define GS_FIT_MAD_K 1.4826
+/* Bounded work for the robust starts: at most this many sample triples. */
+#define GS_FIT_TRIPLES 200u
+/* IRLS stops after this many reweightings even if the weights still move. */
+#define GS_FIT_IRLS_MAX_ITER 10
+/* Fixed PRNG seeds keep every robust fit reproducible. */
+#define GS_FIT_SEED_IRLS 0x9E3779B9u
+#define GS_FIT_SEED_RANSAC 0x2545F491u
+/* Internal floor on the residual scale so that a zero scale cannot divide by 0. */
+#define GS_FIT_TINY_SCALE_PX 1e-6
+
+static const double rad_to_deg = 57.29577951308232;
+
+void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
+{
+    int k;
+    if (!f) {
+        return;
+    }
+    f->t0_s = isfinite(t0_s) ? t0_s : 0.0;
+    /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
+    f->tscale_s = (isfinite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0;
+    for (k = 0; k < 6; k++) {
+        f->r[k] = 0.0;
+    }
+    for (k = 0; k < 3; k++) {
+        f->zx[k] = 0.0;
+        f->zy[k] = 0.0;
+    }
+    f->ssr_x = 0.0;
+    f->ssr_y = 0.0;
+    f->sum_w = 0.0;
+    f->n = 0;
+}
+
+/* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
+static int rix(int i, int j)
+{
+    static const int base[3] = {0, 3, 5};
+    return base[i] + (j - i);
+}
+
+void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w)
+{
+    double v[3], bx, by, sw, tau;
+    int k, j;
+    if (!f || !(w > 0.0) || !isfinite(w) || !isfinite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
+        return;
+    }
+    sw = sqrt(w);
+    tau = (t_s - f->t0_s) / f->tscale_s;
+    v[0] = sw;
+    v[1] = sw * tau;
+    v[2] = sw * tau * tau;
+    bx = sw * x_px;
+    by = sw * y_px;
+    for (k = 0; k < 3; k++) {
+        double a = f->r[rix(k, k)];
+        double b = v[k];
+        double rho, c, s;
+        if (b == 0.0) {
+            continue;
+        }
+        rho = sqrt(a * a + b * b);
+        c = a / rho;
+        s = b / rho;
+        for (j = k; j < 3; j++) {
+            double rkj = f->r[rix(k, j)];
+            f->r[rix(k, j)] = c * rkj + s * v[j];
+            v[j] = c * v[j] - s * rkj;
+        }
+        {
+            double zk = f->zx[k];
+            f->zx[k] = c * zk + s * bx;
+            bx = c * bx - s * zk;
+            zk = f->zy[k];
+            f->zy[k] = c * zk + s * by;
+            by = c * by - s * zk;
+        }
+    }
+    /* What is left of the row after eliminating its basis part is its residual. */
+    f->ssr_x += bx * bx;
+    f->ssr_y += by * by;
+    f->sum_w += w;
+    f->n++;
+}
+
+static void nan_result(gs_fit_result *out)
+{
+    const double nan = (double)NAN;
+    out->x0_px = out->vx_px_s = out->ax_px_s2 = nan;
+    out->y0_px = out->vy_px_s = out->ay_px_s2 = nan;
+    out->a_px_s2 = out->a_se_px_s2 = out->g_dir_deg = out->rms_px = nan;
+}
+
+/* Solve R c = z for the upper-triangular packed R. */
+static void back_sub(const double r[6], const double z[3], double c[3])
+{
+    c[2] = z[2] / r[5];
+    c[1] = (z[1] - r[4] * c[2]) / r[3];
+    c[0] = (z[0] - r[1] * c[1] - r[2] * c[2]) / r[0];
+}
+
+gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
+{
+    double cx[3], cy[3], col[3], ts, ts2, ssr;
+    int k;
+    if (!f || !out) {
+        return GS_EINVAL;
+    }
+    out->t0_s = f->t0_s;
+    out->n = f->n;
+    nan_result(out);
+    if (f->n < 3) {
+        return GS_EINVAL;
+    }
+    /* Column norms of R equal those of the weighted design (Q is orthogonal). */
+    col[0] = fabs(f->r[0]);
+    col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
+    col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
+    for (k = 0; k < 3; k++) {
+        double d = fabs(f->r[rix(k, k)]);
+        if (!(col[k] > 0.0) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
+            return GS_EINVAL;
+        }
+    }
+    back_sub(f->r, f->zx, cx);
+    back_sub(f->r, f->zy, cy);
+    ts = f->tscale_s;
+    ts2 = ts * ts;
+    out->x0_px = cx[0];
+    out->vx_px_s = cx[1] / ts;
+    out->ax_px_s2 = 2.0 * cx[2] / ts2;
+    out->y0_px = cy[0];
+    out->vy_px_s = cy[1] / ts;
+    out->ay_px_s2 = 2.0 * cy[2] / ts2;
+    out->a_px_s2 = sqrt(out->ax_px_s2 * out->ax_px_s2 + out->ay_px_s2 * out->ay_px_s2);
+    out->g_dir_deg = atan2(out->ax_px_s2, out->ay_px_s2) * rad_to_deg;
+    ssr = f->ssr_x + f->ssr_y;
+    out->rms_px = sqrt(ssr / f->sum_w);
+    if (f->n > 3) {
+        /* Pooled over both axes: 2n residuals, 6 coefficients. */
+        double sigma2 = ssr / (2.0 * ((double)f->n - 3.0));
+        /* Row 2 of R^-1 is (0, 0, 1/r22), so [(R^T R)^-1]_22 = 1/r22^2. */
+        double se_c2 = sqrt(sigma2) / fabs(f->r[5]);
+        /* var(ax) = var(ay), so the magnitude's variance is the same. */
+        out->a_se_px_s2 = 2.0 * se_c2 / ts2;
+    }
+    return GS_OK;
+}
+
+const char *gs_fit_method_name(gs_fit_method m)
+{
+    switch (m) {
+    case GS_FIT_IRLS:
+        return "irls";
+    case GS_FIT_RANSAC:
+        return "ransac";
+    case GS_FIT_PLAIN:
+        return "plain";
+    }
+    return "unknown";
+}
+
+bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out)
+{
+    static const gs_fit_method all[3] = {GS_FIT_IRLS, GS_FIT_RANSAC, GS_FIT_PLAIN};
+    size_t i, k;
+    if (!s || !out) {
+        return false;
+    }
+    for (i = 0; i < 3; i++) {
+        const char *name = gs_fit_method_name(all[i]);
+        for (k = 0; k < len && name[k] != '\0' && name[k] == s[k]; k++) {
+        }
+        if (k == len && name[k] == '\0') {
+            *out = all[i];
+            return true;
+        }
+    }
+    return false;
+}
+
+/* ---- robust fits over a ring window ------------------------------------------ */
+
+/* A parabola in tau for both axes: x = c[0] + c[1] tau + c[2] tau^2, y likewise in c[3..5]. */
+typedef struct {
+    double c[6];
+} gs_par;
+
+typedef struct {
+    const gs_ring *ring;
+    uint64_t first;
+    uint32_t count;
+    uint32_t m; /* usable samples in the window */
+    double t0_s, tscale_s;
+} gs_win;
+
+static uint32_t xorshift32(uint32_t *state)
+{
+    uint32_t x = *state;
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    *state = x;
+    return x;
+}
+
+/* Uniform integer in [0, n) for n >= 1 (the modulo bias is irrelevant here). */
+static uint32_t rand_below(uint32_t *state, uint32_t n)
+{
+    return xorshift32(state) % n;
+}
+
+static bool sample_usable(const gs_sample *s)
+{
+    return s && s->w > 0.0f && isfinite(s->w) && isfinite(s->t_s) && isfinite(s->x_px) && isfinite(s->y_px);
+}
+
+static double win_tau(const gs_win *wn, const gs_sample *s)
+{
+    return (s->t_s - wn->t0_s) / wn->tscale_s;
+}
+
+/* Squared 2D distance of a sample from the parabola, in px^2. */
+static double resid2(const gs_par *p, double tau, const gs_sample *s)
+{
+    double ex = (double)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
+    double ey = (double)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
+    return ex * ex + ey * ey;
+}
+
+/* 2D distance of a sample from the parabola, in px. */
+static double resid_norm(const gs_par *p, double tau, const gs_sample *s)
+{
+    return sqrt(resid2(p, tau, s));
+}
+
+/* The parabola through three samples (Newton divided differences); false when two times coincide. */
+static bool par_through(const gs_win *wn, const gs_sample *a, const gs_sample *b, const gs_sample *c, gs_par *p)
+{
+    double ta = win_tau(wn, a), tb = win_tau(wn, b), tc = win_tau(wn, c);
+    double dab = tb - ta, dac = tc - ta, dbc = tc - tb;
+    int axis;
+    if (dab == 0.0 || dac == 0.0 || dbc == 0.0) {
+        return false;
+    }
+    for (axis = 0; axis < 2; axis++) {
+        double va = axis ? a->y_px : a->x_px;
+        double vb = axis ? b->y_px : b->x_px;
+        double vc = axis ? c->y_px : c->x_px;
+        double sab = (vb - va) / dab;
+        double sac = (vc - va) / dac;
+        double c2 = (sac - sab) / dbc;
+        double c1 = sab - c2 * (ta + tb);
+        double c0 = va - ta * (c1 + c2 * ta);
+        p->c[3 * axis + 0] = c0;
+        p->c[3 * axis + 1] = c1;
+        p->c[3 * axis + 2] = c2;
+        if (!isfinite(c0) || !isfinite(c1) || !isfinite(c2)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* k-th smallest of v[0..n) (k < n), reordering v in place (Hoare selection). */
+static float select_kth(float *v, uint32_t n, uint32_t k)
+{
+    int32_t lo = 0, hi = (int32_t)n - 1, kk = (int32_t)k;
+    while (lo < hi) {
+        float pivot = v[lo + (hi - lo) / 2];
+        int32_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot) {
+                i++;
+            }
+            while (v[j] > pivot) {
+                j--;
+            }
+            if (i <= j) {
+                float tmp = v[i];
+                v[i] = v[j];
+                v[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        /* Now v[lo..j] <= pivot <= v[i..hi] and anything between equals the pivot. */
+        if (kk <= j) {
+            hi = j;
+        } else if (kk >= i) {
+            lo = i;
+        } else {
+            return v[kk];
+        }
+    }
+    return v[kk];
+}
+
+/* Median residual norm of the usable samples, using tmp (count floats) as storage. */
+static double median_resid(const gs_win *wn, const gs_par *p, float *tmp)
+{
+    uint32_t i, m = 0;
+    for (i = 0; i < wn->count; i++) {
+        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+        if (sample_usable(s)) {
+            /* Squares order like norms: one sqrt for the median instead of one per sample. */
+            tmp[m++] = (float)resid2(p, win_tau(wn, s), s);
+        }
+    }
+    if (m == 0) {
+        return (double)NAN;
+    }
+    /* Lower median: exact for odd m, robust enough for even m. */
+    return sqrt((double)select_kth(tmp, m, (m - 1) / 2));
+}
+
+/* Tukey biweight of a residual norm r with cut-off cut. */
+static double tukey(double r, double cut)
+{
+    double u;
+    if (!(r < cut)) {
+        return 0.0;
+    }
+    u = r / cut;
+    u = 1.0 - u * u;
+    return u * u;
+}
+
+/* Final weight of one sample under a model: prior * robust factor, as a float. */
+typedef enum { W_PRIOR, W_TUKEY, W_INLIER } w_mode;
+
+static float sample_weight(const gs_win *wn, const gs_sample *s, const gs_par *p, w_mode mode, double cut)
+{
+    double r;
+    if (!sample_usable(s)) {
+        return 0.0f;
+    }
+    if (mode == W_PRIOR) {
+        return s->w;
+    }
+    r = resid_norm(p, win_tau(wn, s), s);
+    if (mode == W_INLIER) {
+        return r <= cut ? s->w : 0.0f;
+    }
+    return (float)((double)s->w * tukey(r, cut));
+}
+
+/* Weighted LS over the window; writes each sample's weight to w_out, the tau-basis parabola to p. */
+static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, double cut, float *w_out,
+                            gs_par *p, gs_fit_result *out)
+{
+    gs_fit f;
+    gs_status st;
+    uint32_t i;
+    gs_fit_init(&f, wn->t0_s, wn->tscale_s);
+    for (i = 0; i < wn->count; i++) {
+        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+        float w = sample_weight(wn, s, model, mode, cut);
+        w_out[i] = w;
+        if (w > 0.0f) {
+            gs_fit_add(&f, s->t_s, s->x_px, s->y_px, (double)w);
+        }
+    }
+    st = gs_fit_solve(&f, out);
+    if (st == GS_OK && p) {
+        back_sub(f.r, f.zx, &p->c[0]);
+        back_sub(f.r, f.zy, &p->c[3]);
+    }
+    return st;
+}
+
+/* Index (into the window) of the k-th usable sample; count must cover it. */
+static uint32_t usable_index(const gs_win *wn, uint32_t k)
+{
+    uint32_t i;
+    if (wn->m == wn->count) {
+        return k; /* the common case: no scan needed */
+    }
+    for (i = 0; i < wn->count; i++) {
+        if (sample_usable(gs_ring_at(wn->ring, wn->first + i))) {
+            if (k == 0) {
+                return i;
+            }
+            k--;
+        }
+    }
+    return wn->count - 1;
+}
+
+/* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
+ * from each third of the usable samples (well spread in time, so the exact
+ * parabola is well conditioned), keep the one with the smallest median
+ * residual. Tolerates almost half the samples being gross outliers. */
+static bool lmeds_start(const gs_win *wn, uint32_t m, float *tmp, gs_par *best, double *best_med)
+{
+    uint32_t state = GS_FIT_SEED_IRLS;
+    uint32_t third = m / 3, k;
+    bool found = false;
+    *best_med = (double)INFINITY;
+    for (k = 0; k < GS_FIT_TRIPLES; k++) {
+        uint32_t ka = rand_below(&state, third);
+        uint32_t kb = third + rand_below(&state, third);
+        uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
+        const gs_sample *a = gs_ring_at(wn->ring, wn->first + usable_index(wn, ka));
+        const gs_sample *b = gs_ring_at(wn->ring, wn->first + usable_index(wn, kb));
+        const gs_sample *c = gs_ring_at(wn->ring, wn->first + usable_index(wn, kc));
+        gs_par p;
+        double med;
+        if (!par_through(wn, a, b, c, &p)) {
+            continue;
+        }
+        med = median_resid(wn, &p, tmp);
+        if (med < *best_med) {
+            *best_med = med;
+            *best = p;
+            found = true;
+        }
+        if (m == 3) {
+            break;
+        }
+    }
+    return found;
+}
+
+static double par_max_shift_px(const gs_par *a, const gs_par *b)
+{
+    static const double taus[3] = {-0.5, 0.0, 0.5};
+    double worst = 0.0;
+    int k;
+    for (k = 0; k < 3; k++) {
+        double t = taus[k];
+        double dx = (a->c[0] - b->c[0]) + t * ((a->c[1] - b->c[1]) + t * (a->c[2] - b->c[2]));
+        double dy = (a->c[3] - b->c[3]) + t * ((a->c[4] - b->c[4]) + t * (a->c[5] - b->c[5]));
+        double d = sqrt(dx * dx + dy * dy);
+        if (!(d <= worst)) {
+            worst = d;
+        }
+    }
+    return worst;
+}
+
+static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+{
+    gs_par cur, next;
+    double med, scale;
+    int it;
+    gs_status st;
+    if (!lmeds_start(wn, m, scratch_w, &cur, &med)) {
+        return GS_EINVAL;
+    }
+    for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
+        med = median_resid(wn, &cur, scratch_w);
+        /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
+        scale = GS_FIT_MAD_K * med;
+        if (!(scale >= floor_px)) {
+            scale = floor_px;
+        }
+        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, scratch_w, &next, out);
+        if (st != GS_OK) {
+            return st;
+        }
+        /* Settled when the curve moves by far less than the noise. */
+        if (par_max_shift_px(&cur, &next) <= 1e-6 * scale) {
+            break;
+        }
+        cur = next;
+    }
+    return GS_OK;
+}
+
+static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+{
+    uint32_t state = GS_FIT_SEED_RANSAC;
+    double thr = 3.0 * floor_px;
+    double best_cost = (double)INFINITY;
+    uint32_t best_in = 0, k, i;
+    gs_par best;
+    bool found = false;
+    for (k = 0; k < GS_FIT_TRIPLES; k++) {
+        uint32_t ka = rand_below(&state, m);
+        uint32_t kb = rand_below(&state, m);
+        uint32_t kc = rand_below(&state, m);
+        const gs_sample *a, *b, *c;
+        gs_par p;
+        uint32_t n_in = 0;
+        double cost = 0.0;
+        if (ka == kb || ka == kc || kb == kc) {
+            continue;
+        }
+        a = gs_ring_at(wn->ring, wn->first + usable_index(wn, ka));
+        b = gs_ring_at(wn->ring, wn->first + usable_index(wn, kb));
+        c = gs_ring_at(wn->ring, wn->first + usable_index(wn, kc));
+        if (!par_through(wn, a, b, c, &p)) {
+            continue;
+        }
+        for (i = 0; i < wn->count; i++) {
+            const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+            double r2;
+            if (!sample_usable(s)) {
+                continue;
+            }
+            r2 = resid2(&p, win_tau(wn, s), s);
+            if (r2 <= thr * thr) {
+                n_in++;
+                cost += r2;
+            }
+        }
+        /* Most inliers wins; ties go to the tighter consensus. */
+        if (n_in > best_in || (n_in == best_in && n_in > 0 && cost < best_cost)) {
+            best_in = n_in;
+            best_cost = cost;
+            best = p;
+            found = true;
+        }
+    }
+    if (!found) {
+        return GS_EINVAL;
+    }
+    return window_fit(wn, &best, W_INLIER, thr, scratch_w, NULL, out);
+}
+
+gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
+                        float min_scale_px, float *scratch_w, gs_fit_result *out)
+{
+    gs_win wn;
+    double t_min = (double)INFINITY, t_max = -(double)INFINITY;
+    double floor_px;
+    uint32_t i, m = 0, n_pos = 0;
+    gs_status st;
+    if (!out) {
+        return GS_EINVAL;
+    }
+    out->t0_s = (double)NAN;
+    out->n = 0;
+    nan_result(out);
+    if (!ring || !scratch_w || count == 0) {
+        return GS_EINVAL;
+    }
+    for (i = 0; i < count; i++) {
+        scratch_w[i] = 0.0f;
+    }
+    for (i = 0; i < count; i++) {
+        const gs_sample *s = gs_ring_at(ring, first + i);
+        if (!s) {
+            /* Overwritten or not yet written: the window is gone. */
+            return GS_EINVAL;
+        }
+        if (sample_usable(s)) {
+            m++;
+            if (s->t_s < t_min) {
+                t_min = s->t_s;
+            }
+            if (s->t_s > t_max) {
+                t_max = s->t_s;
+            }
+        }
+    }
+    if (m < 3 || !(t_max > t_min)) {
+        return GS_EINVAL;
+    }
+    wn.ring = ring;
+    wn.first = first;
+    wn.count = count;
+    wn.m = m;
+    /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
+    wn.t0_s = t_min + 0.5 * (t_max - t_min);
+    wn.tscale_s = t_max - t_min;
+    floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (double)min_scale_px : GS_FIT_TINY_SCALE_PX;
+
+    switch (method) {
+    case GS_FIT_PLAIN:
+        st = window_fit(&wn, NULL, W_PRIOR, 0.0, scratch_w, NULL, out);
+        break;
+    case GS_FIT_IRLS:
+        st = fit_irls(&wn, m, floor_px, scratch_w, out);
+        break;
+    case GS_FIT_RANSAC:
+        st = fit_ransac(&wn, m, floor_px, scratch_w, out);
+        break;
+    default:
+        st = GS_EINVAL;
+        break;
+    }
+    if (st != GS_OK) {
+        for (i = 0; i < count; i++) {
+            scratch_w[i] = 0.0f;
+        }
+        return st;
+    }
+    for (i = 0; i < count; i++) {
+        if (scratch_w[i] > 0.0f) {
+            n_pos++;
+        }
+    }
+    out->n = n_pos;
+    return GS_OK;
+}

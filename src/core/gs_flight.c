@@ -1,0 +1,946 @@
+/* gs_flight.c - online flight detection and per-flight measurement.
+ *
+ * A flight is seeded at a prominent apex of the COM along the image "up"
+ * direction. Its right side then grows sample by sample against the running
+ * fit's prediction until the body is decelerated by the ground (contact shows
+ * as a one-sided deviation against gravity); the left side is grown from the
+ * ring history when the flight closes. Take-off and landing are then refined
+ * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
+ * the boundary) and the final robust 2D fit uses only samples in free flight. */
+#include "gravscale/gs_flight.h"
+
+#include <math.h>
+#include <string.h>
+
+#define GS_PI 3.14159265358979323846
+
+#ifdef GS_FLIGHT_DEBUG
+#include <stdio.h>
+#define DBG(...) fprintf(stderr, __VA_ARGS__)
+#else
+#define DBG(...) ((void)0)
+#endif
+
+/* tuning: thresholds in units of the noise or of the object's size */
+#define SEED_RISE_REL    0.05   /* apex must rise this x size above the recent minimum */
+#define SEED_RISE_NOISE  8.0    /* ... and this x noise */
+#define SEED_DROP_NOISE  2.5    /* apex confirmed once u fell this x noise below it */
+#define CORE_HALF_S      0.07   /* half-width of the seed's core window */
+#define CUSUM_K          1.5    /* CUSUM reference: deviations below k sigma drain it */
+#define CUSUM_H          5.0    /* CUSUM alarm: contact */
+#define VERIFY_Z         2.0    /* after a refit through an alarm, edge samples below this: false alarm */
+#define CUSUM_ZMAX       6.0    /* one sample adds at most this (a lone glitch cannot end a flight) */
+#define BOUNDARY_IN_S    0.025  /* boundary search reaches this far (at least a frame) inside the grown flight */
+#define GROSS_OUTLIER    7.0    /* perpendicular or downward deviation = bad keypoints, skipped */
+#define CONTACT_MIN_G    0.5    /* contact force past a boundary: at least half of g */
+#define DROP_PENALTY     4.0    /* SSR gain (x sigma^2) needed to drop a sample the online test kept */
+#define TAKEOFF_MAX_G    4.0    /* contact force past take-off: (push-off + g) at most 4 g */
+#define LANDING_MAX_G    30.0   /* ... and past landing (impacts are harder) */
+#define CONTACT_SAMPLES_MAX 4   /* contact samples past each boundary seen by the piecewise model */
+#define BOUNDARY_STEPS   4      /* grid points per frame interval for sub-frame boundaries */
+#define STAND_SPEED_REL  0.25   /* standing: |du/dt| below this x size per second */
+#define STAND_UPRIGHT    0.85
+#define NOISE_INIT_N     9      /* second differences whose median starts the noise estimate */
+#define STAND_SETTLE_S   0.3    /* still this long before a frame counts as standing */
+#define EMIT_FACTOR      2.0    /* candidates implying a size beyond [min/2, max*2] are not flights */
+
+static const gs_sample *at(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i); }
+
+static bool usable(const gs_sample *s)
+{
+    return s && s->w > 0.0f && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
+}
+
+static double u_of(const gs_flight *f, const gs_sample *s)
+{
+    return (double)s->x_px * f->up_x + (double)s->y_px * f->up_y;
+}
+
+static void emit(const gs_flight *f, const gs_event *ev)
+{
+    if (f->on_event) f->on_event(f->ctx, ev);
+}
+
+const char *gs_flight_state_name(gs_flight_state s)
+{
+    switch (s) {
+    case GS_FS_IDLE: return "idle";
+    case GS_FS_GROUND: return "ground";
+    case GS_FS_AIRBORNE: return "airborne";
+    }
+    return "?";
+}
+
+static void set_state(gs_flight *f, gs_flight_state to, double t_s)
+{
+    if (f->state == to) return;
+    if (f->trace) {
+        gs_event ev;
+        memset(&ev, 0, sizeof ev);
+        ev.type = GS_EV_STATE;
+        ev.u.state.t_s = t_s;
+        ev.u.state.from = gs_flight_state_name(f->state);
+        ev.u.state.to = gs_flight_state_name(to);
+        emit(f, &ev);
+    }
+    f->state = to;
+}
+
+static void trace_fit(const gs_flight *f, const char *purpose, double t0, double t1,
+                      const gs_fit_result *r)
+{
+    if (!f->trace) return;
+    gs_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.type = GS_EV_FIT;
+    ev.u.fit.purpose = purpose;
+    ev.u.fit.t_first_s = t0;
+    ev.u.fit.t_last_s = t1;
+    ev.u.fit.n = r ? r->n : 0;
+    ev.u.fit.a_px_s2 = r ? r->a_px_s2 : NAN;
+    ev.u.fit.g_dir_deg = r ? r->g_dir_deg : NAN;
+    ev.u.fit.rms_px = r ? r->rms_px : NAN;
+    emit(f, &ev);
+}
+
+/* small sorts for medians of bounded arrays */
+static double median_f(float *v, uint32_t n)
+{
+    if (n == 0) return NAN;
+    for (uint32_t i = 1; i < n; i++) {
+        float x = v[i];
+        uint32_t j = i;
+        while (j > 0 && v[j - 1] > x) { v[j] = v[j - 1]; j--; }
+        v[j] = x;
+    }
+    return (n & 1u) ? (double)v[n / 2] : 0.5 * ((double)v[n / 2 - 1] + (double)v[n / 2]);
+}
+
+static double med3(double a, double b, double c)
+{
+    if (a > b) { double t = a; a = b; b = t; }
+    if (b > c) { b = c; }
+    return a > b ? a : b;
+}
+
+gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
+                         float *scratch_w, bool rigid, gs_event_fn on_event, void *ctx)
+{
+    if (!f || !cfg || !ring || !scratch_w) return GS_EINVAL;
+    memset(f, 0, sizeof *f);
+    f->cfg = cfg;
+    f->ring = ring;
+    f->scratch_w = scratch_w;
+    f->rigid = rigid;
+    f->on_event = on_event;
+    f->ctx = ctx;
+    f->g_m_s2 = gs_core_config_g(cfg);
+    f->state = GS_FS_IDLE;
+    f->next = gs_ring_head(ring);
+    f->quiet_from = f->next;
+    f->last_t_s = NAN;
+    f->up_x = 0.0;
+    f->up_y = -1.0;  /* image up until the body axis or a flight says otherwise */
+    f->noise_px = NAN;
+    f->blk_min_cur = INFINITY;
+    f->blk_min_prev = INFINITY;
+    f->blk_t0 = NAN;
+    f->peak_u = -INFINITY;
+    f->dt_med_s = NAN;
+    f->stand_last_t = NAN;
+    f->still_since = NAN;
+    f->lag_t = NAN;
+    f->lag_u = NAN;
+    f->last_a_px_s2 = NAN;
+    f->last_g_dir_deg = NAN;
+    return GS_OK;
+}
+
+/* ---- per-flight helpers ---------------------------------------------------- */
+
+static double noise_floor(const gs_flight *f)
+{
+    double n = isfinite(f->noise_px) ? f->noise_px : 1.0;
+    return n > 0.05 ? n : 0.05;
+}
+
+/* sigma of one axis from the running fit, at least the ground noise */
+static double fit_sigma(const gs_flight *f, const gs_fit_result *r)
+{
+    double s = noise_floor(f);
+    if (r->n >= 8 && isfinite(r->rms_px)) {
+        double sf = r->rms_px / sqrt(2.0) * sqrt((double)r->n / (double)(r->n - 3));
+        if (sf > s) s = sf;
+    }
+    return s;
+}
+
+/* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) */
+static double pred_var_factor(const gs_fit *fit, double t_s)
+{
+    double tau = (t_s - fit->t0_s) / fit->tscale_s;
+    double x0 = 1.0, x1 = tau, x2 = tau * tau;
+    const double *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
+    if (r[0] == 0.0 || r[3] == 0.0 || r[5] == 0.0) return INFINITY;
+    double z0 = x0 / r[0];
+    double z1 = (x1 - r[1] * z0) / r[3];
+    double z2 = (x2 - r[2] * z0 - r[4] * z1) / r[5];
+    return z0 * z0 + z1 * z1 + z2 * z2;
+}
+
+/* Compare sample s with the fit's prediction. Returns false for a gross
+ * outlier (bad keypoints: far off sideways or below the parabola); else *z is
+ * the deviation against gravity in units of its standard deviation (contact
+ * pushes the body above the parabola, so z grows quadratically after it). */
+static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
+                        const gs_sample *s, double *z)
+{
+    double dt = s->t_s - r->t0_s;
+    double px = r->x0_px + r->vx_px_s * dt + 0.5 * r->ax_px_s2 * dt * dt;
+    double py = r->y0_px + r->vy_px_s * dt + 0.5 * r->ay_px_s2 * dt * dt;
+    double ex = (double)s->x_px - px, ey = (double)s->y_px - py;
+    double gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
+    if (!isfinite(gx) || !isfinite(gy)) { gx = -f->up_x; gy = -f->up_y; }
+    double up = -(ex * gx + ey * gy);
+    double perp = ex * (-gy) + ey * gx;
+    double sig = fit_sigma(f, r);
+    double vf = pred_var_factor(fit, s->t_s);
+    double tot = sig * sqrt(1.0 + (isfinite(vf) ? vf : 1e6));
+    *z = up / tot;
+    return !(fabs(perp) > GROSS_OUTLIER * tot || up < -GROSS_OUTLIER * tot);
+}
+
+/* one-sided CUSUM of z: contact raises it, noise drains it */
+static double cusum_step(double S, double z)
+{
+    if (z > CUSUM_ZMAX) z = CUSUM_ZMAX;
+    S += z - CUSUM_K;
+    return S > 0.0 ? S : 0.0;
+}
+
+/* typical frame interval from the history (for time-based spans) */
+static double frame_dt(const gs_flight *f)
+{
+    return (isfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
+}
+
+static double stand_size(const gs_flight *f, double *se_out);
+
+/* Could this fit be free fall? Acceleration roughly along the expected gravity
+ * direction, and of a size that makes the object's size plausible (loosely:
+ * this gates candidates, the final checks are stricter). */
+static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double size_px)
+{
+    if (!(r->a_px_s2 > 0.0)) return false;
+    double cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
+    double max_ang = f->up_from_flight ? 25.0 : (f->up_n > 0 ? 40.0 : 60.0);
+    if (!(cosang > cos(max_ang * GS_PI / 180.0))) return false;
+    if (isfinite(size_px) && size_px > 0.0) {
+        double h = size_px * f->g_m_s2 / r->a_px_s2;
+        if (h < (double)f->cfg->size_min_m / EMIT_FACTOR || h > (double)f->cfg->size_max_m * EMIT_FACTOR)
+            return false;
+    } else if (isfinite(f->last_a_px_s2)) {
+        if (r->a_px_s2 < f->last_a_px_s2 / EMIT_FACTOR || r->a_px_s2 > f->last_a_px_s2 * EMIT_FACTOR)
+            return false;
+    }
+    return true;
+}
+
+/* the object's size in px for gating: standing stature, or the rigid object's latest size */
+static double gate_size(const gs_flight *f, uint64_t idx)
+{
+    if (f->rigid) {
+        const gs_sample *s = at(f, idx);
+        return s && isfinite(s->size_px) ? (double)s->size_px : NAN;
+    }
+    double se;
+    return stand_size(f, &se);
+}
+
+/* Rebuild the running fit robustly from the ring samples [lo, hi]. */
+static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
+{
+    const gs_sample *a = at(f, lo), *b = at(f, hi);
+    if (!a || !b || hi <= lo) return false;
+    uint32_t count = (uint32_t)(hi - lo + 1);
+    gs_fit_result r;
+    float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
+    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->scratch_w, &r) != GS_OK)
+        return false;
+    double tspan = b->t_s - a->t_s;
+    gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
+    for (uint64_t i = lo; i <= hi; i++) {
+        const gs_sample *s = at(f, i);
+        if (usable(s) && f->scratch_w[i - lo] > 0.0f) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+    }
+    gs_fit_result chk;
+    return gs_fit_solve(&f->fit, &chk) == GS_OK;
+}
+
+/* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
+ * the alarm: if the samples at the edge then sit on the parabola, it was a
+ * false alarm (true contact deviates by far more than a refit can absorb). */
+static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge, int side)
+{
+    if (!refit_range(f, lo, hi)) return false;
+    gs_fit_result r;
+    if (gs_fit_solve(&f->fit, &r) != GS_OK) return false;
+    uint32_t checked = 0;
+    for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
+        const gs_sample *s = at(f, i);
+        double z;
+        if (usable(s)) {
+            if (test_sample(f, &f->fit, &r, s, &z)) {
+                if (z > VERIFY_Z) return false;
+                checked++;
+            }
+        }
+        if (side > 0) { if (i == lo) break; i--; } else { if (i == hi) break; i++; }
+    }
+    return checked == 2;
+}
+
+static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
+{
+    double dt = frame_dt(f);
+    uint32_t half = (uint32_t)ceil(CORE_HALF_S / dt);
+    if (half < 2) half = 2;
+    uint64_t lo = apex >= f->quiet_from + half ? apex - half : f->quiet_from;
+    uint64_t hi = apex + half < newest ? apex + half : newest;
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    if (lo < oldest) lo = oldest;
+    /* need at least 4 usable samples: widen when frames are missing */
+    for (int widen = 0; widen < 8; widen++) {
+        uint32_t n = 0;
+        for (uint64_t i = lo; i <= hi; i++) n += usable(at(f, i)) ? 1u : 0u;
+        if (n >= 5) break;
+        if (lo > f->quiet_from && lo > oldest) lo--;
+        if (hi < newest) hi++;
+    }
+    if (!refit_range(f, lo, hi)) return false;
+    gs_fit_result r;
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || !plausible_fall(f, &r, gate_size(f, apex))) {
+        DBG("seed at %.4f rejected: a=%.1f dir=%.1f\n", at(f, apex)->t_s, r.a_px_s2, r.g_dir_deg);
+        return false;
+    }
+    f->fl_first = lo;
+    f->fl_last = hi;
+    f->seed_idx = apex;
+    f->cusum = 0.0;
+    f->outliers_run = 0;
+    return true;
+}
+
+/* ---- boundary refinement with a piecewise model (1D, along up) ------------- */
+
+/* Solve the k x k (k <= 4) symmetric system A c = b by Cholesky; false if not PD. */
+static bool solve_spd(double A[4][4], double b[4], int k, double c[4])
+{
+    double L[4][4] = {{0}};
+    for (int i = 0; i < k; i++) {
+        for (int j = 0; j <= i; j++) {
+            double s = A[i][j];
+            for (int m = 0; m < j; m++) s -= L[i][m] * L[j][m];
+            if (i == j) {
+                if (!(s > 1e-12 * (A[i][i] > 0 ? A[i][i] : 1.0))) return false;
+                L[i][i] = sqrt(s);
+            } else {
+                L[i][j] = s / L[j][j];
+            }
+        }
+    }
+    double y[4];
+    for (int i = 0; i < k; i++) {
+        double s = b[i];
+        for (int m = 0; m < i; m++) s -= L[i][m] * y[m];
+        y[i] = s / L[i][i];
+    }
+    for (int i = k - 1; i >= 0; i--) {
+        double s = y[i];
+        for (int m = i + 1; m < k; m++) s -= L[m][i] * c[m];
+        c[i] = s / L[i][i];
+    }
+    return true;
+}
+
+/* Weighted SSR of u over samples [lo, hi] under parabola + alpha/2 (T - t)^2 for t < T
+ * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
+ * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
+ * boundary placed inside the flight could absorb flight samples for free. */
+static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double tc, double ts,
+                            double T, int side, double alpha_min_px, double alpha_max_px,
+                            const gs_fit_result *r)
+{
+    double A[4][4] = {{0}}, b[4] = {0}, yy = 0.0;
+    for (uint64_t i = lo; i <= hi; i++) {
+        const gs_sample *s = at(f, i);
+        double z;
+        if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
+        double w = (double)s->w;
+        double tau = (s->t_s - tc) / ts;
+        double d = side < 0 ? (T - s->t_s) : (s->t_s - T);
+        double h = d > 0.0 ? 0.5 * d * d / (ts * ts) : 0.0;
+        double x[4] = {1.0, tau, tau * tau, h};
+        double u = u_of(f, s);
+        for (int k = 0; k < 4; k++) {
+            b[k] += w * x[k] * u;
+            for (int m = 0; m < 4; m++) A[k][m] += w * x[k] * x[m];
+        }
+        yy += w * u * u;
+    }
+    double c[4];
+    double c3_min = alpha_min_px * ts * ts, c3_max = alpha_max_px * ts * ts;  /* alpha in tau units */
+    bool solved = A[3][3] > 0.0 && solve_spd(A, b, 4, c);
+    if (solved && c[3] >= c3_min && c[3] <= c3_max) {
+        double ssr = yy;
+        for (int k = 0; k < 4; k++) ssr -= c[k] * b[k];
+        return ssr > 0.0 ? ssr : 0.0;
+    }
+    /* alpha at a bound: fit the parabola to u - alpha h */
+    double al = A[3][3] > 0.0 ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : 0.0;
+    double b3[4];
+    for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
+    double yy3 = yy - 2.0 * al * b[3] + al * al * A[3][3];
+    if (!solve_spd(A, b3, 3, c)) return INFINITY;
+    double ssr = yy3;
+    for (int k = 0; k < 3; k++) ssr -= c[k] * b3[k];
+    return ssr > 0.0 ? ssr : 0.0;
+}
+
+/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples. */
+static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
+                              uint64_t edge_in, uint64_t edge_out, double alpha_min_px,
+                              double alpha_max_px, double t_grown, double penalty,
+                              const gs_fit_result *r)
+{
+    const gs_sample *a = at(f, lo), *b = at(f, hi);
+    const gs_sample *ei = at(f, edge_in), *eo = at(f, edge_out);
+    if (!a || !b || !ei || !eo) return NAN;
+    double tc = 0.5 * (a->t_s + b->t_s), ts = 0.5 * (b->t_s - a->t_s);
+    if (!(ts > 0.0)) return NAN;
+    /* search between the outermost contact sample and a little inside the flight */
+    double dt = frame_dt(f);
+    double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
+    double t_from = eo->t_s, t_to = ei->t_s + (side < 0 ? inside : -inside);
+    if (side > 0) { double tmp = t_from; t_from = t_to; t_to = tmp; }
+    int steps = (int)ceil((t_to - t_from) / dt * BOUNDARY_STEPS);
+    if (steps < 1) steps = 1;
+    if (steps > 400) steps = 400;
+    double best = INFINITY, best_T = NAN;
+    for (int k = 0; k <= steps; k++) {
+        double T = t_from + (t_to - t_from) * (double)k / (double)steps;
+        double ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
+        /* dropping samples the online test took as flight must pay for itself */
+        if ((side < 0 && T > t_grown) || (side > 0 && T < t_grown)) ssr += penalty;
+        if (ssr < best - 1e-12) { best = ssr; best_T = T; }
+    }
+    return best_T;
+}
+
+/* ---- closing a candidate ---------------------------------------------------- */
+
+static double stand_size(const gs_flight *f, double *se_out)
+{
+    float tmp[GS_STAND_KEEP];
+    uint32_t n = f->stand_n;
+    for (uint32_t i = 0; i < n; i++) tmp[i] = f->stand_size[i];
+    double med = median_f(tmp, n);
+    if (n >= 2) {
+        float dev[GS_STAND_KEEP];
+        for (uint32_t i = 0; i < n; i++) dev[i] = (float)fabs((double)tmp[i] - med);
+        double mad = median_f(dev, n) * 1.4826;
+        *se_out = 1.2533 * mad / sqrt((double)n);
+    } else {
+        *se_out = NAN;
+    }
+    return med;
+}
+
+static double rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, double *se_out)
+{
+    float tmp[64], dev[64];
+    uint32_t n = 0;
+    uint64_t step = (hi - lo + 1 + 63) / 64;
+    if (step == 0) step = 1;
+    for (uint64_t i = lo; i <= hi && n < 64; i += step) {
+        const gs_sample *s = at(f, i);
+        if (s && isfinite(s->size_px) && s->size_px > 0.0f) tmp[n++] = s->size_px;
+    }
+    double med = median_f(tmp, n);
+    if (n >= 2) {
+        for (uint32_t i = 0; i < n; i++) dev[i] = (float)fabs((double)tmp[i] - med);
+        *se_out = 1.2533 * median_f(dev, n) * 1.4826 / sqrt((double)n);
+    } else {
+        *se_out = NAN;
+    }
+    return med;
+}
+
+/* Grow the flight backwards in time from the core with the same CUSUM test.
+ * Every sample but gross outliers enters the running fit (so a biased early
+ * fit corrects itself); the flight's edge is the last sample after which the
+ * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end. */
+static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
+{
+    uint64_t alarm = UINT64_MAX;
+    double max_gap = (double)f->cfg->max_gap_s;
+    uint32_t outl = 0;
+    double S = 0.0;
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
+    const gs_sample *first = at(f, f->fl_first);
+    double t_prev = first ? first->t_s : NAN;
+    const gs_sample *sd = at(f, f->seed_idx);
+    uint64_t clean = f->fl_first;
+    uint64_t i = f->fl_first;
+    while (i > floor_idx) {
+        i--;
+        const gs_sample *s = at(f, i);
+        if (!s) break;
+        if (!usable(s)) continue;
+        if (t_prev - s->t_s > max_gap) break;
+        if (sd && sd->t_s - s->t_s > (double)f->cfg->max_flight_s) break;
+        t_prev = s->t_s;
+        double z;
+        if (!test_sample(f, &f->fit, r, s, &z)) {
+            if (++outl > 2) break;
+            continue;
+        }
+        outl = 0;
+        S = cusum_step(S, z);
+        if (S > CUSUM_H && z > CUSUM_K) {
+            if (alarm_is_false(f, i, f->fl_last, i, -1)) {
+                clean = i;
+                f->fl_first = i;
+                S = 0.0;
+                gs_fit_solve(&f->fit, r);
+                continue;
+            }
+            alarm = i;
+            break;
+        }
+        gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        gs_fit_solve(&f->fit, r);
+        if (S == 0.0) clean = i;
+    }
+    if (clean != f->fl_first || alarm != UINT64_MAX) {
+        f->fl_first = clean;
+        if (refit_range(f, f->fl_first, f->fl_last)) gs_fit_solve(&f->fit, r);
+    }
+    return alarm;
+}
+
+/* Contact samples past the flight edge (side -1: before take-off, +1: after
+ * landing) for the boundary model: consecutive usable samples while their
+ * deviation against gravity keeps growing, as under a constant contact force
+ * (after an impact the body soon stops following it). Returns how many;
+ * *outer = the outermost, *first = the nearest. */
+static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
+                            uint64_t *outer, uint64_t *first)
+{
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
+    uint64_t head = gs_ring_head(f->ring);
+    uint32_t n = 0;
+    double z_prev = -INFINITY;
+    uint64_t i = edge;
+    *outer = edge;
+    *first = edge;
+    while (n < CONTACT_SAMPLES_MAX) {
+        if (side < 0) { if (i <= floor_idx) break; i--; }
+        else { if (i + 1 >= head) break; i++; }
+        const gs_sample *s = at(f, i);
+        if (!usable(s)) continue;
+        double z;
+        if (!test_sample(f, &f->fit, r, s, &z)) continue;  /* a glitch: look past it */
+        if (n > 0 && !(z > z_prev)) break;
+        if (n == 0) *first = i;
+        *outer = i;
+        z_prev = z;
+        n++;
+    }
+    return n;
+}
+
+/* Close the open candidate. right_alarm: the sample at which contact was
+ * detected after the flight (UINT64_MAX when it ended otherwise). */
+static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm, bool truncated)
+{
+    gs_fit_result r;
+    double dt = frame_dt(f);
+    if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
+    uint64_t left_alarm = grow_left(f, &r);
+
+    /* boundary refinement on the up direction of the flight's own acceleration */
+    double save_ux = f->up_x, save_uy = f->up_y;
+    if (isfinite(r.a_px_s2) && r.a_px_s2 > 0.0) {
+        f->up_x = -r.ax_px_s2 / r.a_px_s2;
+        f->up_y = -r.ay_px_s2 / r.a_px_s2;
+    }
+    /* the contact samples the boundary model sees end where contact was detected:
+     * further out the ground phase is no longer a constant force */
+    uint64_t L = f->fl_first, R = f->fl_last;
+    uint64_t lo = L, hi = R;
+    uint32_t n_left = 0, n_right = 0;
+    uint64_t first_left = L, first_right = R;  /* the first contact sample on each side */
+    if (left_alarm != UINT64_MAX) n_left = contact_run(f, &r, L, -1, &lo, &first_left);
+    if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
+    double T0 = NAN, T1 = NAN;
+    double amin = CONTACT_MIN_G * r.a_px_s2;
+    double sig = fit_sigma(f, &r);
+    double pen = DROP_PENALTY * sig * sig;
+    /* two or more contact samples with a growing deviation: a constant-force model
+     * past the boundary gives a sub-frame time; one: the midpoint is all we know */
+    if (n_left >= 2)
+        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, at(f, L)->t_s, pen, &r);
+    else if (n_left == 1)
+        T0 = 0.5 * (at(f, first_left)->t_s + at(f, L)->t_s);
+    if (n_right >= 2)
+        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, at(f, R)->t_s, pen, &r);
+    else if (n_right == 1)
+        T1 = 0.5 * (at(f, first_right)->t_s + at(f, R)->t_s);
+    DBG("close: L=%.4f R=%.4f lo=%.4f hi=%.4f nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
+        at(f, L)->t_s, at(f, R)->t_s, at(f, lo)->t_s, at(f, hi)->t_s, n_left, n_right, T0, T1, r.a_px_s2);
+    /* flight samples: strictly inside (T0, T1) */
+    uint64_t in_lo = lo, in_hi = hi;
+    while (in_lo < in_hi) {
+        const gs_sample *s = at(f, in_lo);
+        if (s && (!isfinite(T0) ? in_lo >= L : s->t_s > T0)) break;
+        in_lo++;
+    }
+    while (in_hi > in_lo) {
+        const gs_sample *s = at(f, in_hi);
+        if (s && (!isfinite(T1) ? in_hi <= R : s->t_s < T1)) break;
+        in_hi--;
+    }
+    f->up_x = save_ux;
+    f->up_y = save_uy;
+
+    const gs_sample *sf = at(f, in_lo), *sl = at(f, in_hi);
+    if (!sf || !sl || in_hi < in_lo) goto done;
+    uint32_t count = (uint32_t)(in_hi - in_lo + 1);
+    gs_fit_result fr;
+    float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
+    gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
+                                 f->scratch_w, &fr);
+    trace_fit(f, "final", sf->t_s, sl->t_s, st == GS_OK ? &fr : NULL);
+
+    /* samples actually inside the flight (usable) and rejected as outliers */
+    uint32_t n_in = 0, n_out = 0;
+    double max_gap_in = 0.0, t_prev = NAN;
+    for (uint64_t i = in_lo; i <= in_hi; i++) {
+        const gs_sample *s = at(f, i);
+        if (!usable(s)) continue;
+        n_in++;
+        if (st == GS_OK && !(f->scratch_w[i - in_lo] > 0.0f)) n_out++;
+        if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
+        t_prev = s->t_s;
+    }
+
+    /* sub-frame times: fall back to half a frame outside the outermost flight sample */
+    if (!isfinite(T0)) T0 = sf->t_s - 0.5 * dt;
+    if (!isfinite(T1)) T1 = sl->t_s + 0.5 * dt;
+
+    gs_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.type = GS_EV_JUMP;
+    gs_ev_jump *j = &ev.u.jump;
+    j->index = f->n_flights;
+    j->t_takeoff_s = T0;
+    j->t_land_s = T1;
+    j->flight_time_s = T1 - T0;
+    j->n_samples = n_in;
+    j->n_outliers = n_out;
+    j->a_px_s2 = j->a_px_se_s2 = j->g_dir_deg = j->q_m_per_px = NAN;
+    j->size_px = j->height_m = j->height_se_m = NAN;
+    j->jump_height_m = j->takeoff_velocity_m_s = j->t_apex_s = j->rms_px = NAN;
+    j->accepted = false;
+    j->reason = GS_REJ_NONE;
+
+    double size_se = NAN;
+    double size = f->rigid ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
+    j->size_px = size;
+
+    if (st != GS_OK) {
+        goto done;  /* nothing fits: not a flight worth reporting */
+    } else {
+        double g = f->g_m_s2;
+        j->a_px_s2 = fr.a_px_s2;
+        j->a_px_se_s2 = fr.a_se_px_s2;
+        j->g_dir_deg = fr.g_dir_deg;
+        j->rms_px = fr.rms_px;
+        j->q_m_per_px = g / fr.a_px_s2;
+        /* apex: where the velocity along gravity is zero */
+        double gx = fr.ax_px_s2 / fr.a_px_s2, gy = fr.ay_px_s2 / fr.a_px_s2;
+        double v_down = fr.vx_px_s * gx + fr.vy_px_s * gy;
+        j->t_apex_s = fr.t0_s - v_down / fr.a_px_s2;
+        double rise_t = j->t_apex_s - T0;
+        j->jump_height_m = 0.5 * g * rise_t * rise_t;
+        j->takeoff_velocity_m_s = g * rise_t;
+        if (isfinite(size)) {
+            j->height_m = size * j->q_m_per_px;
+            double ra = fr.a_se_px_s2 / fr.a_px_s2;
+            double rs = isfinite(size_se) ? size_se / size : 0.0;
+            j->height_se_m = j->height_m * sqrt((isfinite(ra) ? ra * ra : 0.0) + rs * rs);
+        }
+
+        /* is this a flight at all? (walking bumps, standing, noise) */
+        bool flight_like = plausible_fall(f, &fr, size);
+        if (!flight_like) goto done;
+
+        if (n_in < f->cfg->min_samples || j->flight_time_s < (double)f->cfg->min_flight_s)
+            j->reason = GS_REJ_FEW_SAMPLES;
+        else if (max_gap_in > (double)f->cfg->max_gap_s)
+            j->reason = GS_REJ_GAP;
+        else if (!isfinite(size))
+            j->reason = GS_REJ_NO_SIZE;
+        else if (fr.rms_px > (double)f->cfg->max_rms_rel * size)
+            j->reason = GS_REJ_LARGE_RESIDUAL;
+        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (double)f->cfg->max_a_se_rel))
+            j->reason = GS_REJ_UNCERTAIN_A;
+        else if (j->height_m < (double)f->cfg->size_min_m || j->height_m > (double)f->cfg->size_max_m)
+            j->reason = GS_REJ_IMPLAUSIBLE_A;
+        j->accepted = j->reason == GS_REJ_NONE;
+
+        if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
+        if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
+        if (truncated) j->warnings |= GS_WARN_CLIPPED;
+        if (f->n_flights > 0 && isfinite(f->last_g_dir_deg) &&
+            fabs(fr.g_dir_deg - f->last_g_dir_deg) > 10.0)
+            j->warnings |= GS_WARN_GRAVITY_TILT;
+    }
+
+    if (j->accepted) {
+        f->last_a_px_s2 = fr.a_px_s2;
+        f->last_g_dir_deg = isfinite(f->last_g_dir_deg)
+            ? 0.7 * f->last_g_dir_deg + 0.3 * fr.g_dir_deg : fr.g_dir_deg;
+        /* gravity's direction in the image, from the flights themselves */
+        double ux = -fr.ax_px_s2 / fr.a_px_s2, uy = -fr.ay_px_s2 / fr.a_px_s2;
+        if (f->up_from_flight) {
+            ux = 0.7 * f->up_x + 0.3 * ux;
+            uy = 0.7 * f->up_y + 0.3 * uy;
+        }
+        double nrm = sqrt(ux * ux + uy * uy);
+        if (nrm > 0.0) { f->up_x = ux / nrm; f->up_y = uy / nrm; f->up_from_flight = true; }
+    }
+    f->n_flights++;
+    emit(f, &ev);
+
+done:
+    f->quiet_from = newest;
+    {
+        /* next seeds start after the landing: restart the level trackers */
+        const gs_sample *s = at(f, newest);
+        double u = s ? u_of(f, s) : NAN;
+        f->blk_min_cur = isfinite(u) ? u : INFINITY;
+        f->blk_min_prev = f->blk_min_cur;
+        f->blk_t0 = s ? s->t_s : NAN;
+        f->peak_u = -INFINITY;
+        f->n_hist = 0;
+    }
+}
+
+/* ---- the per-sample state machine ------------------------------------------ */
+
+static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s);
+
+static void update_standing(gs_flight *f, const gs_sample *s, double u)
+{
+    /* speed over at least 0.1 s, so that keypoint jitter at high frame rates is not motion */
+    if (!isfinite(f->lag_t) || s->t_s < f->lag_t) { f->lag_t = s->t_s; f->lag_u = u; return; }
+    double span = s->t_s - f->lag_t;
+    if (span < 0.1) return;
+    double speed = fabs(u - f->lag_u) / span;
+    f->lag_t = s->t_s;
+    f->lag_u = u;
+    if (f->rigid || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
+    bool still = speed < STAND_SPEED_REL * (double)s->size_px && s->upright >= STAND_UPRIGHT;
+    if (!still) { f->still_since = NAN; return; }
+    if (!isfinite(f->still_since)) f->still_since = s->t_s;
+    if (s->t_s - f->still_since < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
+    f->stand_size[f->stand_next] = s->size_px;
+    f->stand_next = (f->stand_next + 1u) % GS_STAND_KEEP;
+    if (f->stand_n < GS_STAND_KEEP) f->stand_n++;
+    f->stand_last_t = s->t_s;
+    /* body axis -> image up, until flights measure gravity directly */
+    if (!f->up_from_flight && isfinite(s->up_x) && isfinite(s->up_y)) {
+        double k = f->up_n < 20 ? 1.0 / (double)(f->up_n + 1) : 0.05;
+        double ux = (1.0 - k) * f->up_x + k * (double)s->up_x;
+        double uy = (1.0 - k) * f->up_y + k * (double)s->up_y;
+        if (f->up_n == 0) { ux = s->up_x; uy = s->up_y; }
+        double nrm = sqrt(ux * ux + uy * uy);
+        if (nrm > 0.0) { f->up_x = ux / nrm; f->up_y = uy / nrm; }
+        f->up_n++;
+    }
+}
+
+static double size_ref(const gs_flight *f, const gs_sample *s)
+{
+    if (f->stand_n > 0) {
+        uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
+        return f->stand_size[i];
+    }
+    return (isfinite(s->size_px) && s->size_px > 0.0f) ? (double)s->size_px : NAN;
+}
+
+static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
+{
+    /* history for the median of three and second differences */
+    if (f->n_hist == 3) {
+        f->u_hist[0] = f->u_hist[1]; f->u_hist[1] = f->u_hist[2];
+        f->i_hist[0] = f->i_hist[1]; f->i_hist[1] = f->i_hist[2];
+        f->t_hist[0] = f->t_hist[1]; f->t_hist[1] = f->t_hist[2];
+        f->n_hist = 2;
+    }
+    f->u_hist[f->n_hist] = u_of(f, s);
+    f->i_hist[f->n_hist] = idx;
+    f->t_hist[f->n_hist] = s->t_s;
+    f->n_hist++;
+    if (f->n_hist < 3) return;
+
+    double um = med3(f->u_hist[0], f->u_hist[1], f->u_hist[2]);
+    uint64_t im = f->i_hist[1];
+    double tm = f->t_hist[1];
+    double d2 = f->u_hist[2] - 2.0 * f->u_hist[1] + f->u_hist[0];
+    double sz = size_ref(f, s);
+
+    /* noise: a robust running mean of |second difference| on the ground, started from
+     * the median of the first few (one early glitch must not set it) */
+    if (f->noise_n < NOISE_INIT_N) {
+        f->noise_init[f->noise_n++] = (float)fabs(d2);
+        if (f->noise_n == NOISE_INIT_N) {
+            float tmp[NOISE_INIT_N];
+            for (uint32_t i = 0; i < NOISE_INIT_N; i++) tmp[i] = f->noise_init[i];
+            double med = median_f(tmp, NOISE_INIT_N);
+            f->noise_px = med / 1.652;  /* median |N(0, 6 s^2)| = 1.652 s */
+            if (f->noise_px < 0.05) f->noise_px = 0.05;
+        }
+    } else {
+        double a = fabs(d2) / 1.954;  /* E|N(0, 6 s^2)| = 1.954 s */
+        if (a > 3.0 * f->noise_px) a = 3.0 * f->noise_px;
+        f->noise_px += 0.02 * (a - f->noise_px);
+    }
+    update_standing(f, s, f->u_hist[2]);
+
+    /* recent minimum over two half-second blocks */
+    if (!isfinite(f->blk_t0)) f->blk_t0 = tm;
+    if (tm - f->blk_t0 > 0.5) {
+        f->blk_min_prev = f->blk_min_cur;
+        f->blk_min_cur = INFINITY;
+        f->blk_t0 = tm;
+    }
+    if (um < f->blk_min_cur) f->blk_min_cur = um;
+    double umin = f->blk_min_cur < f->blk_min_prev ? f->blk_min_cur : f->blk_min_prev;
+
+    double nz = noise_floor(f);
+    double thr = SEED_RISE_NOISE * nz;
+    if (isfinite(sz) && SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;
+    if (um - umin > thr) {
+        if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; }
+        else {
+            double drop = SEED_DROP_NOISE * nz;
+            if (isfinite(sz) && 0.01 * sz > drop) drop = 0.01 * sz;
+            if (f->peak_u - um > drop) {
+                if (seed_core(f, f->peak_idx, idx)) {
+                    set_state(f, GS_FS_AIRBORNE, f->peak_t);
+                    /* samples after the core that arrived meanwhile are tested in order */
+                    for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
+                        const gs_sample *p = at(f, i);
+                        if (usable(p)) airborne_sample(f, i, p);
+                    }
+                } else {
+                    f->peak_u = -INFINITY;
+                }
+            }
+        }
+    } else {
+        f->peak_u = -INFINITY;
+    }
+}
+
+static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample *s)
+{
+    /* the running fit saw samples past the edge: rebuild it over the clean range */
+    refit_range(f, f->fl_first, f->fl_last);
+    close_candidate(f, idx, alarm, false);
+    set_state(f, GS_FS_GROUND, s->t_s);
+}
+
+static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
+{
+    gs_fit_result r;
+    if (idx <= f->fl_last) return;  /* already in the seed's core */
+    const gs_sample *seed = at(f, f->seed_idx);
+    if (gs_fit_solve(&f->fit, &r) != GS_OK ||
+        (seed && s->t_s - seed->t_s > (double)f->cfg->max_flight_s)) {
+        land(f, idx, UINT64_MAX, s);
+        return;
+    }
+    if (r.n >= 8 && !plausible_fall(f, &r, gate_size(f, idx))) {  /* a standing phase, not a flight */
+        land(f, idx, UINT64_MAX, s);
+        return;
+    }
+    double z;
+    bool ok = test_sample(f, &f->fit, &r, s, &z);
+    DBG("t=%.4f ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", s->t_s, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
+    if (!ok) {
+        if (++f->outliers_run >= 3) land(f, idx, UINT64_MAX, s);
+        return;
+    }
+    f->outliers_run = 0;
+    f->cusum = cusum_step(f->cusum, z);
+    if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
+        if (alarm_is_false(f, f->fl_first, idx, idx, +1)) {
+            f->fl_last = idx;
+            f->cusum = 0.0;
+            return;
+        }
+        land(f, idx, idx, s);
+        return;
+    }
+    gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+    if (f->cusum == 0.0) f->fl_last = idx;
+}
+
+void gs_flight_update(gs_flight *f)
+{
+    uint64_t head = gs_ring_head(f->ring);
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */
+    while (f->next < head) {
+        uint64_t idx = f->next++;
+        const gs_sample *s = at(f, idx);
+        if (!usable(s)) continue;
+        if (isfinite(f->last_t_s)) {
+            double dt = s->t_s - f->last_t_s;
+            if (dt > 0.0) {
+                if (!isfinite(f->dt_med_s)) f->dt_med_s = dt;
+                else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
+            }
+            if (dt > (double)f->cfg->max_gap_s) {
+                if (f->state == GS_FS_AIRBORNE) {
+                    close_candidate(f, f->last_idx, UINT64_MAX, true);
+                }
+                f->n_hist = 0;
+                f->peak_u = -INFINITY;
+                f->blk_min_cur = f->blk_min_prev = INFINITY;
+                f->blk_t0 = NAN;
+                set_state(f, GS_FS_GROUND, s->t_s);
+            }
+        }
+        f->last_t_s = s->t_s;
+        f->last_idx = idx;
+        if (f->state == GS_FS_IDLE) set_state(f, GS_FS_GROUND, s->t_s);
+        if (f->state == GS_FS_AIRBORNE) airborne_sample(f, idx, s);
+        else ground_sample(f, idx, s);
+    }
+}
+
+void gs_flight_finish(gs_flight *f)
+{
+    gs_flight_update(f);
+    if (f->state == GS_FS_AIRBORNE) {
+        close_candidate(f, f->last_idx, UINT64_MAX, true);
+        set_state(f, GS_FS_GROUND, f->last_t_s);
+    }
+}

@@ -1,0 +1,140 @@
+/* gs_pipeline.c - keypoints -> COM sample -> ring -> flights -> aggregate -> events. */
+#include "gravscale/gs_pipeline.h"
+
+#include <math.h>
+#include <string.h>
+
+#define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~((size_t)(a) - 1u))
+
+size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
+{
+    if (!cfg) return 0;
+    size_t cap = cfg->ring_capacity;
+    return ALIGN_UP(cap * sizeof(gs_sample), 8u) + ALIGN_UP(cap * sizeof(float), 8u);
+}
+
+/* Flight events pass through here: accepted jumps feed the aggregate, which
+ * reports the running height right after the jump. */
+static void on_flight_event(void *ctx, const gs_event *ev)
+{
+    gs_pipeline *p = (gs_pipeline *)ctx;
+    if (p->on_event) p->on_event(p->ctx, ev);
+    if (ev->type != GS_EV_JUMP) return;
+    if (ev->u.jump.accepted) {
+        gs_agg_add(&p->agg, ev->u.jump.height_m, ev->u.jump.height_se_m);
+        gs_event h;
+        memset(&h, 0, sizeof h);
+        h.type = GS_EV_HEIGHT;
+        gs_agg_get(&p->agg, &h.u.height);
+        h.u.height.track = ev->u.jump.track;
+        if (p->on_event) p->on_event(p->ctx, &h);
+    } else {
+        gs_agg_reject(&p->agg);
+    }
+}
+
+gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout layout,
+                           void *storage, size_t storage_bytes,
+                           gs_event_fn on_event, void *ctx)
+{
+    if (!p || !cfg || !storage || gs_layout_kp_count(layout) == 0) return GS_EINVAL;
+    if (((uintptr_t)storage & 7u) != 0) return GS_EINVAL;
+    size_t need = gs_pipeline_storage_bytes(cfg);
+    if (need == 0 || storage_bytes < need) return GS_ENOMEM;
+    memset(p, 0, sizeof *p);
+    p->cfg = *cfg;
+    p->layout = layout;
+    p->on_event = on_event;
+    p->ctx = ctx;
+    p->last_t_s = NAN;
+    uint32_t cap = cfg->ring_capacity;
+    gs_sample *samples = (gs_sample *)storage;
+    float *scratch = (float *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
+    gs_status st = gs_ring_init(&p->ring, samples, cap);
+    if (st != GS_OK) return st;
+    gs_agg_init(&p->agg);
+    return gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
+                          on_flight_event, p);
+}
+
+void gs_pipeline_set_trace(gs_pipeline *p, bool on)
+{
+    if (p) p->flight.trace = on;
+}
+
+static gs_status push_sample(gs_pipeline *p, const gs_sample *s)
+{
+    if (p->finished) return GS_ESTATE;
+    if (!isfinite(s->t_s)) return GS_EINVAL;
+    if (isfinite(p->last_t_s)) {
+        if (s->t_s < p->last_t_s) return GS_EORDER;
+        if (s->t_s == p->last_t_s) return GS_OK;  /* a repeated frame carries nothing new */
+    }
+    p->last_t_s = s->t_s;
+    p->n_frames++;
+    gs_ring_push(&p->ring, s);
+    if (p->flight.trace && p->on_event) {
+        gs_event ev;
+        memset(&ev, 0, sizeof ev);
+        ev.type = GS_EV_SAMPLE;
+        ev.u.sample.t_s = s->t_s;
+        ev.u.sample.x_px = s->x_px;
+        ev.u.sample.y_px = s->y_px;
+        ev.u.sample.w = s->w;
+        ev.u.sample.size_px = s->size_px;
+        ev.u.sample.upright = s->upright;
+        p->on_event(p->ctx, &ev);
+    }
+    gs_flight_update(&p->flight);
+    return GS_OK;
+}
+
+gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp)
+{
+    if (!p || !kp) return GS_EINVAL;
+    gs_com_out c;
+    gs_status st = gs_com_compute(p->layout, p->cfg.mass_table, p->cfg.stature, p->cfg.min_conf, kp, &c);
+    if (st != GS_OK) return st;
+    gs_sample s;
+    s.t_s = t_s;
+    s.x_px = c.x_px;
+    s.y_px = c.y_px;
+    s.w = (isfinite(c.x_px) && isfinite(c.y_px)) ? c.w : 0.0f;
+    s.size_px = c.stature_px;
+    s.up_x = c.up_x;
+    s.up_y = c.up_y;
+    s.upright = c.upright;
+    s.reserved = 0.0f;
+    return push_sample(p, &s);
+}
+
+gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px,
+                                 float c, float size_px)
+{
+    if (!p) return GS_EINVAL;
+    gs_sample s;
+    s.t_s = t_s;
+    s.x_px = x_px;
+    s.y_px = y_px;
+    s.w = (isfinite(x_px) && isfinite(y_px) && c > 0.0f) ? (c < 1.0f ? c : 1.0f) : 0.0f;
+    s.size_px = size_px;
+    s.up_x = NAN;
+    s.up_y = NAN;
+    s.upright = 1.0f;
+    s.reserved = 0.0f;
+    return push_sample(p, &s);
+}
+
+gs_status gs_pipeline_flush(gs_pipeline *p)
+{
+    if (!p) return GS_EINVAL;
+    if (p->finished) return GS_ESTATE;
+    gs_flight_finish(&p->flight);
+    p->finished = true;
+    gs_event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.type = GS_EV_SUMMARY;
+    gs_agg_get(&p->agg, &ev.u.height);
+    if (p->on_event) p->on_event(p->ctx, &ev);
+    return GS_OK;
+}

@@ -1,0 +1,319 @@
+/* test_flight.c - flight detection and measurement against simulated truth.
+ * A COM track with a countermovement, constant-force propulsion, an exactly
+ * ballistic flight, a hard landing and recovery is sampled at a camera rate
+ * and fed through the pipeline (point layout, so sizes come with the samples). */
+#include "unity.h"
+#include "gravscale/gravscale.h"
+
+#include <math.h>
+#include <string.h>
+
+#define MAX_JUMPS 16
+#define PI 3.14159265358979323846
+
+/* ---- a deterministic PRNG and Gaussian ------------------------------------- */
+static uint64_t rng_state;
+static double urand(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (double)(rng_state >> 11) / 9007199254740992.0;
+}
+static double nrand(void)
+{
+    double u1 = urand(), u2 = urand();
+    if (u1 < 1e-300) u1 = 1e-300;
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * PI * u2);
+}
+
+/* ---- simulated vertical COM track (metres, up positive) -------------------- */
+typedef struct {
+    double t_start;   /* start of countermovement */
+    double v0;        /* take-off velocity */
+    double t_takeoff, t_land;
+} sim_jump;
+
+typedef struct {
+    double g, a_prop, a_land, rise_ext, cm_dur, rec_dur;
+    sim_jump jumps[MAX_JUMPS];
+    int n;
+} sim_track;
+
+/* u(t) of one jump relative to standing, 0 outside its span */
+static double jump_u(const sim_track *s, const sim_jump *j, double t, bool *airborne)
+{
+    double D = j->v0 * j->v0 / (2.0 * s->a_prop) - s->rise_ext;  /* dip depth */
+    double tp = j->v0 / s->a_prop;                                 /* propulsion time */
+    double t1 = j->t_start + s->cm_dur;                            /* bottom of the dip */
+    double tf = 2.0 * j->v0 / s->g;
+    double tl = j->v0 / s->a_land;
+    double u_to = -D + j->v0 * j->v0 / (2.0 * s->a_prop);
+    *airborne = false;
+    if (t < j->t_start) return 0.0;
+    if (t < t1) return -D * 0.5 * (1.0 - cos(PI * (t - j->t_start) / s->cm_dur));
+    if (t < t1 + tp) { double x = t - t1; return -D + 0.5 * s->a_prop * x * x; }
+    double x = t - (t1 + tp);
+    if (x < tf) { *airborne = true; return u_to + j->v0 * x - 0.5 * s->g * x * x; }
+    x -= tf;
+    if (x < tl) return u_to - j->v0 * x + 0.5 * s->a_land * x * x;
+    double u_bot = u_to - j->v0 * j->v0 / (2.0 * s->a_land);
+    x -= tl;
+    if (x < s->rec_dur) return u_bot * 0.5 * (1.0 + cos(PI * x / s->rec_dur));
+    return 0.0;
+}
+
+static double track_u(const sim_track *s, double t, bool *airborne)
+{
+    *airborne = false;
+    for (int k = 0; k < s->n; k++) {
+        const sim_jump *j = &s->jumps[k];
+        double end = j->t_land + j->v0 / s->a_land + s->rec_dur;
+        if (t >= j->t_start && t < end) return jump_u(s, j, t, airborne);
+    }
+    return 0.0;
+}
+
+static void make_track(sim_track *s, int n, double first, double spacing, double v0_lo, double v0_hi)
+{
+    memset(s, 0, sizeof *s);
+    s->g = 9.81;
+    s->a_prop = 14.0;
+    s->a_land = 30.0;
+    s->rise_ext = 0.08;
+    s->cm_dur = 0.45;
+    s->rec_dur = 0.5;
+    s->n = n;
+    for (int k = 0; k < n; k++) {
+        sim_jump *j = &s->jumps[k];
+        j->t_start = first + spacing * k;
+        j->v0 = v0_lo + (v0_hi - v0_lo) * (n > 1 ? (double)k / (n - 1) : 0.5);
+        j->t_takeoff = j->t_start + s->cm_dur + j->v0 / s->a_prop;
+        j->t_land = j->t_takeoff + 2.0 * j->v0 / s->g;
+    }
+}
+
+/* ---- event capture ------------------------------------------------------------ */
+typedef struct {
+    gs_ev_jump jumps[MAX_JUMPS * 4];
+    double emitted_at[MAX_JUMPS * 4];   /* time of the newest sample pushed when it came */
+    int n_jumps;
+    gs_ev_height summary;
+    int n_height, n_summary;
+    double now;
+} capture;
+
+static void on_event(void *ctx, const gs_event *ev)
+{
+    capture *c = (capture *)ctx;
+    if (ev->type == GS_EV_JUMP && c->n_jumps < MAX_JUMPS * 4) {
+        c->emitted_at[c->n_jumps] = c->now;
+        c->jumps[c->n_jumps++] = ev->u.jump;
+    } else if (ev->type == GS_EV_HEIGHT) {
+        c->n_height++;
+    } else if (ev->type == GS_EV_SUMMARY) {
+        c->summary = ev->u.height;
+        c->n_summary++;
+    }
+}
+
+typedef struct {
+    double fps, q_m_per_px, roll_deg, noise_px, size_m, outlier_rate, phase;
+} cam;
+
+static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(double) + 8];
+
+static void run(const sim_track *s, const cam *c, capture *cap, double t_end)
+{
+    gs_core_config cfg;
+    gs_core_config_default(&cfg);
+    cfg.ring_capacity = 1024;
+    cfg.size_min_m = 0.01f;
+    static gs_pipeline p;
+    memset(cap, 0, sizeof *cap);
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, cap));
+    double ca = cos(c->roll_deg * PI / 180.0), sa = sin(c->roll_deg * PI / 180.0);
+    double size_px = c->size_m / c->q_m_per_px;
+    for (long i = 0;; i++) {
+        double t = (i + c->phase) / c->fps;
+        if (t > t_end) break;
+        bool air;
+        double u = track_u(s, t, &air);
+        /* image: y down; the body drifts slowly sideways; camera roll rotates both */
+        double X = 0.05 * t, Y = u;
+        double xi = 960.0 + (X * ca - Y * sa) / c->q_m_per_px;
+        double yi = 700.0 - (X * sa + Y * ca) / c->q_m_per_px;
+        xi += c->noise_px * nrand();
+        yi += c->noise_px * nrand();
+        if (urand() < c->outlier_rate) { xi += 40.0 * (urand() - 0.5) * 2.0; yi += 40.0 * (urand() - 0.5) * 2.0; }
+        cap->now = t;
+        TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, t, (float)xi, (float)yi, 1.0f,
+                                                        (float)(size_px + 0.3 * c->noise_px * nrand())));
+    }
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
+    TEST_ASSERT_EQUAL(1, cap->n_summary);
+}
+
+/* match each true jump to one accepted event; return count matched */
+static int match(const sim_track *s, const capture *cap, int *map)
+{
+    int found = 0;
+    for (int k = 0; k < s->n; k++) {
+        map[k] = -1;
+        for (int e = 0; e < cap->n_jumps; e++) {
+            const gs_ev_jump *j = &cap->jumps[e];
+            if (!j->accepted) continue;
+            if (fabs(j->t_takeoff_s - s->jumps[k].t_takeoff) < 0.1 && fabs(j->t_land_s - s->jumps[k].t_land) < 0.1) {
+                map[k] = e;
+                found++;
+                break;
+            }
+        }
+    }
+    return found;
+}
+
+void setUp(void) { rng_state = 0x9E3779B97F4A7C15ull; }
+void tearDown(void) {}
+
+/* Noise-free at 30 fps: every flight, a within 0.3 %, boundaries within half a frame. */
+static void test_exact_track_30fps(void)
+{
+    sim_track s;
+    make_track(&s, 4, 1.5, 2.5, 1.4, 2.8);
+    cam c = {30.0, 0.003, 0.0, 0.0, 0.20, 0.0, 0.37};
+    capture cap;
+    run(&s, &c, &cap, 12.0);
+    int map[MAX_JUMPS];
+    TEST_ASSERT_EQUAL_INT(4, match(&s, &cap, map));
+    TEST_ASSERT_EQUAL_INT(4, cap.n_jumps);  /* nothing else reported */
+    double a_true = 9.81 / 0.003;
+    for (int k = 0; k < 4; k++) {
+        const gs_ev_jump *j = &cap.jumps[map[k]];
+        TEST_ASSERT_DOUBLE_WITHIN(0.003 * a_true, a_true, j->a_px_s2);
+        TEST_ASSERT_DOUBLE_WITHIN(0.5 / 30.0, s.jumps[k].t_takeoff, j->t_takeoff_s);
+        TEST_ASSERT_DOUBLE_WITHIN(0.5 / 30.0, s.jumps[k].t_land, j->t_land_s);
+        TEST_ASSERT_DOUBLE_WITHIN(0.003 * 0.20, 0.20, j->height_m);
+        double v0 = s.jumps[k].v0;
+        TEST_ASSERT_DOUBLE_WITHIN(0.03 * v0, v0, j->takeoff_velocity_m_s);
+        TEST_ASSERT_DOUBLE_WITHIN(0.05 * v0 * v0 / 19.62 + 0.005, v0 * v0 / 19.62, j->jump_height_m);
+        /* emitted within 0.2 s of the true landing */
+        TEST_ASSERT_TRUE(cap.emitted_at[map[k]] <= s.jumps[k].t_land + 0.2);
+    }
+    TEST_ASSERT_EQUAL_UINT32(4, cap.summary.n_jumps);
+    TEST_ASSERT_DOUBLE_WITHIN(0.001, 0.20, cap.summary.height_m);
+}
+
+/* Noisy at 30 fps with outliers and 30 deg roll: a within 3 SE per flight, gravity direction found. */
+static void test_noisy_rolled(void)
+{
+    sim_track s;
+    make_track(&s, 5, 1.5, 2.5, 1.6, 2.8);
+    cam c = {30.0, 0.003, 30.0, 1.0, 0.20, 0.02, 0.11};
+    capture cap;
+    run(&s, &c, &cap, 15.0);
+    int map[MAX_JUMPS];
+    TEST_ASSERT_EQUAL_INT(5, match(&s, &cap, map));
+    double a_true = 9.81 / 0.003;
+    for (int k = 0; k < 5; k++) {
+        const gs_ev_jump *j = &cap.jumps[map[k]];
+        TEST_ASSERT_DOUBLE_WITHIN(3.0 * j->a_px_se_s2 + 0.005 * a_true, a_true, j->a_px_s2);
+        TEST_ASSERT_TRUE(j->a_px_se_s2 < 0.06 * a_true);
+        /* the rotation used here turns gravity toward +x: direction +30 deg */
+        double dir_se_deg = j->a_px_se_s2 / j->a_px_s2 * 57.2958;
+        TEST_ASSERT_DOUBLE_WITHIN(3.0 * dir_se_deg + 0.5, 30.0, j->g_dir_deg);
+        /* 1 px noise against a first contact deviation of ~1-2 px: 1.5 frames */
+        TEST_ASSERT_DOUBLE_WITHIN(1.5 / 30.0, s.jumps[k].t_takeoff, j->t_takeoff_s);
+        TEST_ASSERT_DOUBLE_WITHIN(1.5 / 30.0, s.jumps[k].t_land, j->t_land_s);
+    }
+    TEST_ASSERT_DOUBLE_WITHIN(0.004, 0.20, cap.summary.height_m);
+}
+
+/* 120 fps in light noise: a within 3 SE (SE under 2.5 %), boundaries within two frames (17 ms). */
+static void test_120fps(void)
+{
+    sim_track s;
+    make_track(&s, 3, 1.5, 2.5, 1.2, 2.6);
+    cam c = {120.0, 0.005, 0.0, 0.3, 0.20, 0.0, 0.5};
+    capture cap;
+    run(&s, &c, &cap, 10.0);
+    int map[MAX_JUMPS];
+    TEST_ASSERT_EQUAL_INT(3, match(&s, &cap, map));
+    double a_true = 9.81 / 0.005;
+    for (int k = 0; k < 3; k++) {
+        const gs_ev_jump *j = &cap.jumps[map[k]];
+        TEST_ASSERT_DOUBLE_WITHIN(3.0 * j->a_px_se_s2 + 0.002 * a_true, a_true, j->a_px_s2);
+        TEST_ASSERT_TRUE(j->a_px_se_s2 < 0.025 * a_true);  /* theory: 1.3 % for the 0.25 s flight */
+        TEST_ASSERT_DOUBLE_WITHIN(2.0 / 120.0, s.jumps[k].t_takeoff, j->t_takeoff_s);
+        TEST_ASSERT_DOUBLE_WITHIN(2.0 / 120.0, s.jumps[k].t_land, j->t_land_s);
+    }
+}
+
+/* Standing still with noise (and slow sway): nothing reported, summary unknown. */
+static void test_no_flight(void)
+{
+    sim_track s;
+    make_track(&s, 0, 0.0, 0.0, 0.0, 0.0);
+    cam c = {30.0, 0.003, 0.0, 1.5, 0.20, 0.01, 0.0};
+    capture cap;
+    run(&s, &c, &cap, 30.0);
+    TEST_ASSERT_EQUAL_INT(0, cap.n_jumps);
+    TEST_ASSERT_EQUAL_UINT32(0, cap.summary.n_jumps);
+    TEST_ASSERT_TRUE(isnan(cap.summary.height_m));
+    TEST_ASSERT_TRUE(isnan(cap.summary.ci95_lo_m));
+}
+
+/* Dropped frames inside flights (10 %) still give every flight. */
+static void test_time_gaps(void)
+{
+    sim_track s;
+    make_track(&s, 3, 1.5, 2.5, 2.0, 2.6);
+    gs_core_config cfg;
+    gs_core_config_default(&cfg);
+    cfg.size_min_m = 0.01f;
+    static gs_pipeline p;
+    capture cap;
+    memset(&cap, 0, sizeof cap);
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    for (long i = 0; i < 300; i++) {
+        if (i % 10 == 7) continue;  /* a dropped frame: its timestamp is simply absent */
+        double t = i / 30.0;
+        bool air;
+        double u = track_u(&s, t, &air);
+        TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, t, 500.0f, (float)(600.0 - u / 0.003), 1.0f, 66.7f));
+    }
+    gs_pipeline_flush(&p);
+    int map[MAX_JUMPS];
+    TEST_ASSERT_EQUAL_INT(3, match(&s, &cap, map));
+    for (int k = 0; k < 3; k++)
+        TEST_ASSERT_DOUBLE_WITHIN(0.005 * 3270.0, 3270.0, cap.jumps[map[k]].a_px_s2);
+}
+
+static void test_bad_calls(void)
+{
+    gs_core_config cfg;
+    gs_core_config_default(&cfg);
+    static gs_pipeline p;
+    capture cap;
+    TEST_ASSERT_EQUAL(GS_ENOMEM, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, 16, on_event, &cap));
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_init(&p, &cfg, (gs_layout)99, storage, sizeof storage, on_event, &cap));
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, 1.0, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_EORDER, gs_pipeline_push_point(&p, 0.5, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_push_point(&p, NAN, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
+    TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_push_point(&p, 2.0, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_flush(&p));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_exact_track_30fps);
+    RUN_TEST(test_noisy_rolled);
+    RUN_TEST(test_120fps);
+    RUN_TEST(test_no_flight);
+    RUN_TEST(test_time_gaps);
+    RUN_TEST(test_bad_calls);
+    return UNITY_END();
+}

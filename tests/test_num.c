@@ -1,0 +1,472 @@
+/* test_num.c - gs_num against libc (strtod, snprintf) as the reference. */
+#include "gravscale/gs_num.h"
+#include "unity.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+void setUp(void) {}
+void tearDown(void) {}
+
+/* deterministic PRNG (splitmix64) so failures reproduce */
+static uint64_t g_rng = 0x9E3779B97F4A7C15ull;
+static uint64_t rnd64(void)
+{
+    uint64_t z = (g_rng += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+static double rnd_unit(void) { return (double)(rnd64() >> 11) * (1.0 / 9007199254740992.0); }
+
+/* a random finite double with a random exponent over the whole range */
+static double rnd_any_double(void)
+{
+    for (;;) {
+        uint64_t b = rnd64();
+        double d;
+        memcpy(&d, &b, sizeof d);
+        if (isfinite(d)) return d;
+    }
+}
+
+/* distance in ulps between two finite doubles of the same sign */
+static uint64_t ulp_dist(double a, double b)
+{
+    int64_t ia, ib;
+    memcpy(&ia, &a, 8);
+    memcpy(&ib, &b, 8);
+    if (ia < 0) ia = INT64_MIN - ia;
+    if (ib < 0) ib = INT64_MIN - ib;
+    return ia > ib ? (uint64_t)(ia - ib) : (uint64_t)(ib - ia);
+}
+
+static bool parse_str(const char *s, double *out) { return gs_num_parse(s, strlen(s), out); }
+
+/* ------------------------------------------------------------ parse table */
+typedef struct {
+    const char *in;
+    bool ok;
+} parse_case;
+
+static const parse_case k_parse_cases[] = {
+    {"0", true},      {"-0", true},    {"1e308", true},  {"1e309", false}, {"1e-320", true},
+    {".5", true},     {"5.", true},    {"+1", true},     {"", false},      {"-", false},
+    {"1e", false},    {"1e+", false},  {"1.2.3", false}, {"nan", false},   {"inf", false},
+    {" 1", false},    {"1 ", false},   {"0x10", false},  {".", false},     {"+", false},
+    {"-.", false},    {"e5", false},   {".e5", false},   {"1e5.5", false}, {"--1", false},
+    {"1e-400", true}, {"2.4703282292062328e-324", true}, {"2.4703282292062327e-324", true},
+    {"4.9406564584124654e-324", true}, {"2.2250738585072011e-308", true},
+    {"2.2250738585072014e-308", true}, {"1.7976931348623157e308", true},
+    {"1.7976931348623158e308", true},  {"1.7976931348623159e308", false},
+    {"9007199254740993", true},        {"9007199254740992.5", true},
+    {"123456789012345678901234567890", true}, {"0.000000000000000000000000000000001", true},
+    {"1e+00000000000000000000000000005", true}, {"1e-99999999999999999999", true},
+    {"1e99999999999999999999", false}, {"00000000000000000000000000001.5", true},
+    {"1.00000000000000000000000000000000000000000000001", true},
+    {"-1.5E-3", true}, {"1E3", true}, {"3.14159", true}, {"1,5", false}, {"1e3x", false},
+};
+
+void test_parse_table(void)
+{
+    for (size_t i = 0; i < sizeof k_parse_cases / sizeof k_parse_cases[0]; i++) {
+        const parse_case *c = &k_parse_cases[i];
+        double got = 12345.0;
+        bool ok = parse_str(c->in, &got);
+        char msg[160];
+        snprintf(msg, sizeof msg, "input \"%s\"", c->in);
+        TEST_ASSERT_EQUAL_MESSAGE(c->ok, ok, msg);
+        if (!ok) {
+            TEST_ASSERT_EQUAL_DOUBLE_MESSAGE(12345.0, got, msg); /* out untouched */
+            continue;
+        }
+        double ref = strtod(c->in, NULL);
+        /* these are all exact-path inputs: bit-identical to libc, signs of zero included */
+        TEST_ASSERT_TRUE_MESSAGE(memcmp(&ref, &got, sizeof got) == 0, msg);
+    }
+    double z = 1.0;
+    TEST_ASSERT_TRUE(parse_str("-0", &z));
+    TEST_ASSERT_TRUE(signbit(z));
+    /* 1e-320 is a subnormal and comes back as one (not flushed to 0) */
+    TEST_ASSERT_TRUE(parse_str("1e-320", &z));
+    TEST_ASSERT_TRUE(z > 0 && z < 2.2250738585072014e-308);
+    /* exact length is honoured: "12" out of "123" */
+    TEST_ASSERT_TRUE(gs_num_parse("123", 2, &z));
+    TEST_ASSERT_EQUAL_DOUBLE(12.0, z);
+    TEST_ASSERT_FALSE(gs_num_parse(NULL, 0, &z));
+}
+
+/* --------------------------------------------------------- parse random */
+/* significant digits of a decimal string's mantissa (trailing zeros count) */
+static int sig_digits(const char *s)
+{
+    int n = 0;
+    bool started = false;
+    for (; *s && *s != 'e' && *s != 'E'; s++) {
+        if (*s < '0' || *s > '9') continue;
+        if (*s != '0') started = true;
+        if (started) n++;
+    }
+    return n;
+}
+void test_parse_random_vs_strtod(void)
+{
+    static const char *fmts[] = {"%.17g", "%.16g", "%.15g", "%.6g", "%.3f", "%.1f", "%.9e", "%.0f"};
+    char s[64];
+    long n = 0, exact = 0, one_ulp = 0;
+    for (int it = 0; it < 20000; it++) {
+        double v;
+        if (it % 3 == 0) v = rnd_any_double();
+        else if (it % 3 == 1) v = (rnd_unit() - 0.5) * 4000.0;
+        else v = ldexp(rnd_unit(), (int)(rnd64() % 200) - 100);
+        for (size_t f = 0; f < sizeof fmts / sizeof fmts[0]; f++) {
+            int len = snprintf(s, sizeof s, fmts[f], v);
+            if (len <= 0 || len >= (int)sizeof s) continue;
+            double ref = strtod(s, NULL), got = 0;
+            TEST_ASSERT_TRUE_MESSAGE(gs_num_parse(s, (size_t)len, &got), s);
+            uint64_t d = ulp_dist(ref, got);
+            TEST_ASSERT_TRUE_MESSAGE(d <= 1, s);
+            /* up to 15 significant digits every path is exact */
+            if (sig_digits(s) <= 15) {
+                TEST_ASSERT_TRUE_MESSAGE(d == 0, s);
+            }
+            n++;
+            exact += d == 0;
+            one_ulp += d == 1;
+        }
+    }
+    printf("parse random: %ld values, %ld bit-exact, %ld off by 1 ulp (17-19 digit fast path)\n", n, exact,
+           one_ulp);
+}
+
+/* long mantissas and big exponents go the exact big-integer way: bit-identical */
+void test_parse_long_digits_exact(void)
+{
+    char s[900];
+    for (int it = 0; it < 3000; it++) {
+        int nd = 20 + (int)(rnd64() % (it < 100 ? 780 : 40));
+        size_t n = 0;
+        if (rnd64() & 1) s[n++] = '-';
+        int point = (int)(rnd64() % (unsigned)(nd + 1));
+        for (int i = 0; i < nd; i++) {
+            if (i == point) s[n++] = '.';
+            s[n++] = (char)('0' + rnd64() % 10);
+        }
+        int e = (int)(rnd64() % 700) - 350;
+        n += (size_t)snprintf(s + n, sizeof s - n, "e%d", e);
+        double ref = strtod(s, NULL), got = 0;
+        bool ok = gs_num_parse(s, n, &got);
+        if (isinf(ref)) {
+            TEST_ASSERT_FALSE_MESSAGE(ok, s);
+            continue;
+        }
+        TEST_ASSERT_TRUE_MESSAGE(ok, s);
+        TEST_ASSERT_TRUE_MESSAGE(memcmp(&ref, &got, 8) == 0, s);
+    }
+    /* exact halfway cases between doubles decided by a digit far away */
+    const char *halfway[] = {
+        "9007199254740993",                       /* 2^53 + 1: tie, even -> 2^53 */
+        "9007199254740993.0000000000000000000001", /* just above the tie -> up */
+        "9007199254740992.9999999999999999999999",
+        "2.47032822920623272088284396434110686182529901307162382212792841250337753635104375932649918180817996189898282347722858865463328355177969898199387398005390939063150356595155702263922908583924491051844359318028499365361525003193704576782492193656236698636584807570015857692699037063119282795585513329278343384093519780155312465972635795746227664652728272200563740064854999770965994704540208281662262378573934507363390079677619305775067401763246736009689513405355374585166611342237666786041621596804619144672918403005300575308490487653917113865916462395249126236538818796362393732804238910186723484976682350898633885879256283027559956575244555072551893136908362547791869486679949683240497058210285131854513962138377228261454376934125320985913276672363281255e-324",
+    };
+    for (size_t i = 0; i < sizeof halfway / sizeof halfway[0]; i++) {
+        double ref = strtod(halfway[i], NULL), got = 0;
+        TEST_ASSERT_TRUE(parse_str(halfway[i], &got));
+        TEST_ASSERT_TRUE_MESSAGE(memcmp(&ref, &got, 8) == 0, halfway[i]);
+    }
+}
+
+void test_parse_speed(void)
+{
+    enum { N = 2000000 };
+    static char text[N * 12];
+    static size_t off[N + 1];
+    size_t n = 0;
+    for (int i = 0; i < N; i++) {
+        off[i] = n;
+        n += (size_t)snprintf(text + n, sizeof text - n, "%.3f", (rnd_unit() - 0.3) * 2000.0);
+    }
+    off[N] = n;
+    clock_t t0 = clock();
+    double sum = 0;
+    for (int i = 0; i < N; i++) {
+        double v;
+        TEST_ASSERT_TRUE(gs_num_parse(text + off[i], off[i + 1] - off[i], &v));
+        sum += v;
+    }
+    double dt = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    printf("parse speed: %.1f million numbers/s (\"%%.3f\" keypoint-like values, checksum %.3f)\n",
+           N / dt / 1e6, sum);
+    TEST_ASSERT_TRUE(dt > 0);
+}
+
+/* --------------------------------------------------------------- parse_int */
+void test_parse_int_table(void)
+{
+    static const struct {
+        const char *in;
+        bool ok;
+        long v;
+    } c[] = {
+        {"0", true, 0},      {"-0", true, 0},   {"+7", true, 7},     {"512", true, 512},
+        {"", false, 0},      {"-", false, 0},   {"1.0", false, 0},   {" 1", false, 0},
+        {"1 ", false, 0},    {"0x10", false, 0}, {"1e3", false, 0},  {"9223372036854775807", true, 9223372036854775807L},
+        {"-9223372036854775808", true, (-9223372036854775807L - 1)},
+        {"9223372036854775808", false, 0},  {"-9223372036854775809", false, 0},
+        {"99999999999999999999999", false, 0},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        long v = 4242;
+        bool ok = gs_num_parse_int(c[i].in, strlen(c[i].in), &v);
+        TEST_ASSERT_EQUAL_MESSAGE(c[i].ok, ok, c[i].in);
+        TEST_ASSERT_TRUE_MESSAGE(v == (ok ? c[i].v : 4242), c[i].in);
+    }
+}
+
+/* ------------------------------------------------------ formatting oracle */
+/* The reference rounds glibc's exact expansion half away from zero. */
+static bool ref_fixed(double v, int dec, char *out)
+{
+    static char exact[1400];
+    snprintf(exact, sizeof exact, "%.1100f", fabs(v)); /* glibc prints the exact binary value */
+    char *pt = strchr(exact, '.');
+    size_t ni = (size_t)(pt - exact);
+    char dig[64];
+    size_t nd = 0;
+    bool tie = pt[1 + dec] == '5' && strspn(pt + 2 + dec, "0") == strlen(pt + 2 + dec);
+    for (size_t i = 0; i < ni; i++) dig[nd++] = exact[i];
+    for (int i = 0; i < dec; i++) dig[nd++] = pt[1 + i];
+    if (pt[1 + dec] >= '5') {
+        size_t i = nd;
+        while (i > 0 && dig[i - 1] == '9') dig[--i] = '0';
+        if (i == 0) {
+            memmove(dig + 1, dig, nd++);
+            dig[0] = '1';
+        } else {
+            dig[i - 1]++;
+        }
+    }
+    bool zero = true;
+    for (size_t i = 0; i < nd; i++) zero = zero && dig[i] == '0';
+    size_t n = 0;
+    if (v < 0 && !zero) out[n++] = '-';
+    size_t nint = nd - (size_t)dec;
+    for (size_t i = 0; i < nint; i++) out[n++] = dig[i];
+    if (dec) {
+        out[n++] = '.';
+        for (int i = 0; i < dec; i++) out[n++] = dig[nint + (size_t)i];
+    }
+    out[n] = 0;
+    return tie;
+}
+
+static void ref_sig(double v, int sig, char *out)
+{
+    static char exact[1400];
+    snprintf(exact, sizeof exact, "%.1100e", fabs(v));
+    char dig[32];
+    dig[0] = exact[0];
+    for (int i = 1; i < sig; i++) dig[i] = exact[1 + i];
+    int k = atoi(strchr(exact, 'e') + 1);
+    if (exact[1 + sig] >= '5') {
+        int i = sig;
+        while (i > 0 && dig[i - 1] == '9') dig[--i] = '0';
+        if (i == 0) {
+            dig[0] = '1';
+            k++;
+        } else {
+            dig[i - 1]++;
+        }
+    }
+    int nk = sig;
+    while (nk > 1 && dig[nk - 1] == '0') nk--;
+    dig[nk] = 0;
+    size_t n = 0;
+    if (v < 0) out[n++] = '-';
+    if (k >= -4 && k <= 14) {
+        if (k >= 0) {
+            for (int i = 0; i <= k; i++) out[n++] = i < nk ? dig[i] : '0';
+            if (nk > k + 1) {
+                out[n++] = '.';
+                for (int i = k + 1; i < nk; i++) out[n++] = dig[i];
+            }
+        } else {
+            n += (size_t)sprintf(out + n, "0.%.*s%s", -k - 1, "0000", dig);
+        }
+        out[n] = 0;
+    } else {
+        sprintf(out + n, "%c%s%s%se%c%02d", dig[0], nk > 1 ? "." : "", dig + 1, "", k < 0 ? '-' : '+',
+                k < 0 ? -k : k);
+    }
+}
+
+typedef struct {
+    double v;
+    int d;
+    const char *want;
+} fmt_case;
+
+void test_fmt_fixed_table(void)
+{
+    static const fmt_case c[] = {
+        {0.125, 2, "0.13"},   /* exact tie: half away from zero (glibc's %.2f gives 0.12) */
+        {-0.125, 2, "-0.13"},
+        {2.5, 0, "3"},        {-2.5, 0, "-3"},
+        {0.145, 2, "0.14"},   /* binary 0.14499999999999999 */
+        {-0.0, 3, "0.000"},   {-0.0004, 3, "0.000"},  {0.0005, 3, "0.001"},
+        {999.9996, 3, "1000.000"}, {0, 0, "0"},  {1.5, 9, "1.500000000"},
+        {123456789012345.6, 0, "123456789012346"},  {-999999999999999.9, 0, "-1000000000000000"},
+        {1e-300, 4, "0.0000"}, {5e-324, 9, "0.000000000"}, {0.99999999995, 9, "1.000000000"},
+        {12.3456, 4, "12.3456"}, {-1.23456789, 3, "-1.235"},
+    };
+    char buf[64];
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        size_t n = gs_num_fmt_fixed(buf, sizeof buf, c[i].v, c[i].d);
+        TEST_ASSERT_EQUAL_STRING_MESSAGE(c[i].want, buf, c[i].want);
+        TEST_ASSERT_EQUAL(strlen(c[i].want), n);
+    }
+    /* not representable: 0 and "" */
+    const double bad[] = {NAN, INFINITY, -INFINITY, 1e15, -1e15, 1e300};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        strcpy(buf, "xx");
+        TEST_ASSERT_EQUAL(0, gs_num_fmt_fixed(buf, sizeof buf, bad[i], 3));
+        TEST_ASSERT_EQUAL_STRING("", buf);
+    }
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_fixed(buf, sizeof buf, 1.0, 10));
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_fixed(buf, sizeof buf, 1.0, -1));
+}
+
+void test_fmt_fixed_random_vs_libc(void)
+{
+    char got[64], want[64], libc[64];
+    long ties = 0, n = 0;
+    for (int it = 0; it < 40000; it++) {
+        double v;
+        switch (it % 4) {
+        case 0: v = (rnd_unit() - 0.5) * 2e4; break;
+        case 1: v = ldexp(rnd_unit() - 0.5, (int)(rnd64() % 100) - 60); break;
+        case 2: v = (double)(int64_t)(rnd64() % 2000000 - 1000000) / 1000.0; break; /* many exact ties */
+        default: v = (double)(int64_t)(rnd64() % 20000 - 10000) / 8.0; break;       /* x.125 ties */
+        }
+        int d = (int)(rnd64() % 10);
+        size_t len = gs_num_fmt_fixed(got, sizeof got, v, d);
+        bool tie = ref_fixed(v, d, want);
+        TEST_ASSERT_EQUAL_STRING(want, got);
+        TEST_ASSERT_EQUAL(strlen(want), len);
+        snprintf(libc, sizeof libc, "%.*f", d, v);
+        const char *lc = strcmp(libc, "-0") == 0 || strncmp(libc, "-0.", 3) == 0 ? libc + 1 : libc;
+        bool negz = lc != libc && strspn(lc, "0.") == strlen(lc);
+        if (!negz) lc = libc;
+        if (strcmp(lc, got) != 0) {
+            /* only exact ties may differ from glibc's half-to-even */
+            TEST_ASSERT_TRUE_MESSAGE(tie, got);
+            ties++;
+        }
+        n++;
+    }
+    printf("fmt_fixed random: %ld values equal to the exact half-away reference; %ld differ from glibc "
+           "(exact ties, glibc rounds half to even)\n",
+           n, ties);
+}
+
+void test_fmt_sig_table(void)
+{
+    static const fmt_case c[] = {
+        {1.5e-05, 6, "1.5e-05"},   {0.0001, 6, "0.0001"},    {0.00012345678, 3, "0.000123"},
+        {9.81, 6, "9.81"},         {-9.81, 6, "-9.81"},      {123456.0, 3, "123000"},
+        {1e15, 6, "1e+15"},        {999999999999999.0, 15, "999999999999999"},
+        {999999999999999.0, 6, "1e+15"}, {0.0, 6, "0"},      {-0.0, 6, "0"},
+        {1e300, 6, "1e+300"},      {-2.5e-308, 2, "-2.5e-308"}, {5e-324, 3, "4.94e-324"},
+        {0.00099999, 2, "0.001"},  {0.000099999, 2, "0.0001"}, {1234.5678, 6, "1234.57"},
+        {0.0023456789, 6, "0.00234568"}, {30.0, 6, "30"}, {29.97002997, 6, "29.97"},
+        {2.5, 1, "3"},             {1.7976931348623157e308, 15, "1.79769313486232e+308"},
+    };
+    char buf[64];
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        size_t n = gs_num_fmt_sig(buf, sizeof buf, c[i].v, c[i].d);
+        TEST_ASSERT_EQUAL_STRING_MESSAGE(c[i].want, buf, c[i].want);
+        TEST_ASSERT_EQUAL(strlen(c[i].want), n);
+    }
+    const double bad[] = {NAN, INFINITY, -INFINITY};
+    for (size_t i = 0; i < 3; i++) {
+        strcpy(buf, "xx");
+        TEST_ASSERT_EQUAL(0, gs_num_fmt_sig(buf, sizeof buf, bad[i], 6));
+        TEST_ASSERT_EQUAL_STRING("", buf);
+    }
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_sig(buf, sizeof buf, 1.0, 0));
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_sig(buf, sizeof buf, 1.0, 16));
+}
+
+/* every output is a JSON number that parses back to within its rounding */
+void test_fmt_sig_random(void)
+{
+    char got[64], want[64];
+    for (int it = 0; it < 30000; it++) {
+        double v = (it & 1) ? rnd_any_double() : ldexp(rnd_unit() - 0.5, (int)(rnd64() % 80) - 40);
+        int sig = 1 + (int)(rnd64() % 15);
+        size_t len = gs_num_fmt_sig(got, sizeof got, v, sig);
+        ref_sig(v, sig, want);
+        TEST_ASSERT_EQUAL_STRING(want, got);
+        TEST_ASSERT_EQUAL(strlen(want), len);
+        double back = 0;
+        TEST_ASSERT_TRUE_MESSAGE(gs_num_parse(got, len, &back), got);
+        /* half a unit of the last digit plus the re-parse rounding (2 ulp) */
+        TEST_ASSERT_TRUE_MESSAGE(fabs(back - v) <= fabs(v) * (pow(10, 1 - sig) * 0.5 + 0x1p-51), got);
+        TEST_ASSERT_NULL(strpbrk(got, "infa"));
+    }
+}
+
+/* canaries: neither formatter writes at or past cap, and a short cap gives "" */
+void test_fmt_caps_canary(void)
+{
+    const double vals[] = {0.0, -1.25, 123456.789, -9.99999e-200, 1e14, 0.00042};
+    for (size_t vi = 0; vi < sizeof vals / sizeof vals[0]; vi++) {
+        for (int which = 0; which < 2; which++) {
+            char full[64];
+            size_t need = which ? gs_num_fmt_sig(full, sizeof full, vals[vi], 7)
+                                : gs_num_fmt_fixed(full, sizeof full, vals[vi], 4);
+            if (which == 0 && fabs(vals[vi]) < 1e-100) {
+                TEST_ASSERT_EQUAL_STRING("0.0000", full);
+            }
+            TEST_ASSERT_TRUE(need > 0);
+            for (size_t cap = 0; cap <= need + 3; cap++) {
+                char buf[80];
+                memset(buf, 0xA5, sizeof buf);
+                size_t n = which ? gs_num_fmt_sig(buf + 8, cap, vals[vi], 7)
+                                 : gs_num_fmt_fixed(buf + 8, cap, vals[vi], 4);
+                for (size_t i = 0; i < 8; i++) TEST_ASSERT_EQUAL_HEX8(0xA5, (uint8_t)buf[i]);
+                for (size_t i = 8 + cap; i < sizeof buf; i++) TEST_ASSERT_EQUAL_HEX8(0xA5, (uint8_t)buf[i]);
+                if (cap > need) {
+                    TEST_ASSERT_EQUAL(need, n);
+                    TEST_ASSERT_EQUAL_STRING(full, buf + 8);
+                } else {
+                    TEST_ASSERT_EQUAL(0, n);
+                    if (cap) {
+                        TEST_ASSERT_EQUAL_HEX8(0, (uint8_t)buf[8]);
+                    }
+                }
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_fixed(NULL, 0, 1.0, 2));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_parse_table);
+    RUN_TEST(test_parse_random_vs_strtod);
+    RUN_TEST(test_parse_long_digits_exact);
+    RUN_TEST(test_parse_speed);
+    RUN_TEST(test_parse_int_table);
+    RUN_TEST(test_fmt_fixed_table);
+    RUN_TEST(test_fmt_fixed_random_vs_libc);
+    RUN_TEST(test_fmt_sig_table);
+    RUN_TEST(test_fmt_sig_random);
+    RUN_TEST(test_fmt_caps_canary);
+    return UNITY_END();
+}
