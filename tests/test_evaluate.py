@@ -134,6 +134,18 @@ class BaselineExact(unittest.TestCase):
         acc = [j for j in pb.analyse(pb.read_keypoints_csv(path))[0] if j["accepted"]]
         self.assertLess(abs(acc[0]["q_m_per_px"] / q - 1.0), 1e-6)
 
+    def test_min_rise_gate(self):
+        # a 4 px hop (rise 4 px, 2.2 % of the 187 px stature) and a real jump, at 60 fps
+        q = 0.003
+        path = os.path.join(self.tmp.name, "m.csv")
+        write_trial_csv(path, q, [(2.0, 2.1), (3.5, 4.0)], fps=60.0)
+        frames = pb.read_keypoints_csv(path)
+        paper = [j for j in pb.analyse(frames)[0] if j["accepted"]]
+        self.assertEqual([round(j["t_apex_s"], 6) for j in paper], [2.05, 3.75])
+        gated = [j for j in pb.analyse(frames, min_rise=0.05)[0] if j["accepted"]]
+        self.assertEqual([round(j["t_apex_s"], 6) for j in gated], [3.75])
+        self.assertEqual(len([j for j in pb.analyse(frames, min_rise=0.02)[0] if j["accepted"]]), 2)
+
     def test_cli_prints_gravscale_shaped_lines(self):
         q = 0.00281
         path = os.path.join(self.tmp.name, "c.csv")

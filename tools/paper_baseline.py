@@ -288,8 +288,10 @@ def com_track(frames):
     return out
 
 
-def analyse(frames, use_ransac=False, min_conf=MIN_MEAN_CONF, g=G_M_S2):
-    """Run the paper's steps on decoded frames; returns (jumps, stature_px)."""
+def analyse(frames, use_ransac=False, min_conf=MIN_MEAN_CONF, g=G_M_S2, min_rise=0.0):
+    """Run the paper's steps on decoded frames; returns (jumps, stature_px).
+    min_rise (OURS, 0 = the paper): a maximum must rise at least this fraction of
+    stature_px above the floor, a stand-in for the paper's hand-picked snippets."""
     size_px = stature_px(frames)
     track = com_track(frames)
     ts = [p[0] for p in track]
@@ -300,7 +302,10 @@ def analyse(frames, use_ransac=False, min_conf=MIN_MEAN_CONF, g=G_M_S2):
         return jumps, size_px
     floor = floor_level(u)
     seen = set()
+    rise_px = min_rise * size_px if math.isfinite(size_px) else 0.0
     for m in find_maxima(u):
+        if min_rise > 0.0 and not u[m] - floor >= rise_px:
+            continue
         iv = flight_interval(u, m, floor)
         if iv is None or iv in seen:
             continue
@@ -389,10 +394,15 @@ def main(argv=None):
     ap.add_argument("--min-conf", type=float, default=MIN_MEAN_CONF,
                     help="drop frames from the fit whose mean keypoint confidence is below this")
     ap.add_argument("--g", type=float, default=G_M_S2, help="gravity, m/s^2")
+    ap.add_argument("--min-rise", type=float, default=0.0,
+                    help="OURS, not the paper (0): ignore maxima rising less than this fraction "
+                         "of the stature in px above the floor (e.g. 0.05)")
     args = ap.parse_args(argv)
     frames = read_keypoints_csv(args.csv)
-    jumps, _ = analyse(frames, use_ransac=args.ransac, min_conf=args.min_conf, g=args.g)
-    name = "paper-ransac" if args.ransac else "paper"
+    jumps, _ = analyse(frames, use_ransac=args.ransac, min_conf=args.min_conf, g=args.g,
+                       min_rise=args.min_rise)
+    name = ("paper-ransac" if args.ransac else "paper") + \
+        ("" if args.min_rise <= 0.0 else " min-rise %g" % args.min_rise)
     for ev in events(jumps, name):
         sys.stdout.write(json.dumps(ev, allow_nan=False) + "\n")
     return 0

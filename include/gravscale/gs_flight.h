@@ -61,14 +61,16 @@ typedef struct {
     uint64_t fl_first, fl_last;   /* accepted range so far (absolute ring indices) */
     uint64_t seed_idx;
     double cusum;              /* one-sided CUSUM of the deviation against gravity */
+    uint32_t pend_ok;          /* bit k: pending sample fl_last+1+k is no gross outlier */
     uint32_t outliers_run;     /* consecutive gross outliers */
     double dt_med_s;           /* typical frame interval */
 
     float stand_size[GS_STAND_KEEP];
     uint32_t stand_n, stand_next;
+    float loose_size[GS_STAND_KEEP]; /* still, roughly upright frames: a fallback */
+    uint32_t loose_n, loose_next;
     double stand_last_t;
     double still_since;        /* start of the current still, upright stretch, NaN none */
-    double lag_t, lag_u;       /* u at least 0.1 s back, for a jitter-proof speed */
 
     double last_a_px_s2;       /* last accepted acceleration, NaN none */
     double last_g_dir_deg;

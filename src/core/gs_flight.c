@@ -39,9 +39,10 @@
 #define CONTACT_SAMPLES_MAX 4   /* contact samples past each boundary seen by the piecewise model */
 #define BOUNDARY_STEPS   4      /* grid points per frame interval for sub-frame boundaries */
 #define STAND_SPEED_REL  0.25   /* standing: |du/dt| below this x size per second */
-#define STAND_UPRIGHT    0.85
+#define STAND_UPRIGHT    0.7
+#define LOOSE_UPRIGHT    0.5    /* fallback size samples (no settled stance seen yet) */
 #define NOISE_INIT_N     9      /* second differences whose median starts the noise estimate */
-#define STAND_SETTLE_S   0.3    /* still this long before a frame counts as standing */
+#define STAND_SETTLE_S   0.2    /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      2.0    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
 static const gs_sample *at(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i); }
@@ -149,8 +150,6 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->dt_med_s = NAN;
     f->stand_last_t = NAN;
     f->still_since = NAN;
-    f->lag_t = NAN;
-    f->lag_u = NAN;
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
     return GS_OK;
@@ -232,16 +231,21 @@ static double stand_size(const gs_flight *f, double *se_out);
 static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double size_px)
 {
     if (!(r->a_px_s2 > 0.0)) return false;
+    /* a fit of few noisy samples gets the benefit of two standard errors */
+    double rel_se = (isfinite(r->a_se_px_s2) && r->a_se_px_s2 > 0.0) ? r->a_se_px_s2 / r->a_px_s2 : 0.0;
     double cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
     double max_ang = f->up_from_flight ? 25.0 : (f->up_n > 0 ? 40.0 : 60.0);
+    max_ang += 2.0 * rel_se * 180.0 / GS_PI;
+    if (max_ang > 80.0) max_ang = 80.0;
     if (!(cosang > cos(max_ang * GS_PI / 180.0))) return false;
+    double a_hi = r->a_px_s2 + 2.0 * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - 2.0 * rel_se * r->a_px_s2;
     if (isfinite(size_px) && size_px > 0.0) {
-        double h = size_px * f->g_m_s2 / r->a_px_s2;
-        if (h < (double)f->cfg->size_min_m / EMIT_FACTOR || h > (double)f->cfg->size_max_m * EMIT_FACTOR)
-            return false;
+        /* the size this acceleration implies, h = size g / a, within the plausible range */
+        double a_min = size_px * f->g_m_s2 / ((double)f->cfg->size_max_m * EMIT_FACTOR);
+        double a_max = size_px * f->g_m_s2 / ((double)f->cfg->size_min_m / EMIT_FACTOR);
+        if (a_hi < a_min || a_lo > a_max) return false;
     } else if (isfinite(f->last_a_px_s2)) {
-        if (r->a_px_s2 < f->last_a_px_s2 / EMIT_FACTOR || r->a_px_s2 > f->last_a_px_s2 * EMIT_FACTOR)
-            return false;
+        if (a_hi < f->last_a_px_s2 / EMIT_FACTOR || a_lo > f->last_a_px_s2 * EMIT_FACTOR) return false;
     }
     return true;
 }
@@ -300,16 +304,16 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     return checked == 2;
 }
 
-static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
+static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double half_s)
 {
     double dt = frame_dt(f);
-    uint32_t half = (uint32_t)ceil(CORE_HALF_S / dt);
+    uint32_t half = (uint32_t)ceil(half_s / dt - 1e-9);
     if (half < 2) half = 2;
     uint64_t lo = apex >= f->quiet_from + half ? apex - half : f->quiet_from;
     uint64_t hi = apex + half < newest ? apex + half : newest;
     uint64_t oldest = gs_ring_oldest(f->ring);
     if (lo < oldest) lo = oldest;
-    /* need at least 4 usable samples: widen when frames are missing */
+    /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
         uint32_t n = 0;
         for (uint64_t i = lo; i <= hi; i++) n += usable(at(f, i)) ? 1u : 0u;
@@ -320,15 +324,25 @@ static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
     if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
     if (gs_fit_solve(&f->fit, &r) != GS_OK || !plausible_fall(f, &r, gate_size(f, apex))) {
-        DBG("seed at %.4f rejected: a=%.1f dir=%.1f\n", at(f, apex)->t_s, r.a_px_s2, r.g_dir_deg);
+        DBG("seed at %.4f (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", at(f, apex)->t_s, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
         return false;
     }
     f->fl_first = lo;
     f->fl_last = hi;
     f->seed_idx = apex;
     f->cusum = 0.0;
+    f->pend_ok = 0;
     f->outliers_run = 0;
     return true;
+}
+
+/* Seed a flight at an apex: fit a core around it, wider when noise hides the curve. */
+static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
+{
+    static const double half_s[] = {CORE_HALF_S, CORE_HALF_S * 1.45, CORE_HALF_S * 1.9};
+    for (unsigned k = 0; k < sizeof half_s / sizeof half_s[0]; k++)
+        if (seed_core_width(f, apex, newest, half_s[k])) return true;
+    return false;
 }
 
 /* ---- boundary refinement with a piecewise model (1D, along up) ------------- */
@@ -439,21 +453,28 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
 
 /* ---- closing a candidate ---------------------------------------------------- */
 
-static double stand_size(const gs_flight *f, double *se_out)
+static double median_se(const float *v, uint32_t n, double *se_out)
 {
-    float tmp[GS_STAND_KEEP];
-    uint32_t n = f->stand_n;
-    for (uint32_t i = 0; i < n; i++) tmp[i] = f->stand_size[i];
+    float tmp[GS_STAND_KEEP], dev[GS_STAND_KEEP];
+    for (uint32_t i = 0; i < n; i++) tmp[i] = v[i];
     double med = median_f(tmp, n);
     if (n >= 2) {
-        float dev[GS_STAND_KEEP];
         for (uint32_t i = 0; i < n; i++) dev[i] = (float)fabs((double)tmp[i] - med);
-        double mad = median_f(dev, n) * 1.4826;
-        *se_out = 1.2533 * mad / sqrt((double)n);
+        *se_out = 1.2533 * median_f(dev, n) * 1.4826 / sqrt((double)n);
     } else {
         *se_out = NAN;
     }
     return med;
+}
+
+/* standing size: settled upright frames, else (no stance seen yet) still frames that are
+ * roughly upright */
+static double stand_size(const gs_flight *f, double *se_out)
+{
+    if (f->stand_n >= 3) return median_se(f->stand_size, f->stand_n, se_out);
+    if (f->loose_n >= 3) return median_se(f->loose_size, f->loose_n, se_out);
+    *se_out = NAN;
+    return NAN;
 }
 
 static double rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, double *se_out)
@@ -566,6 +587,7 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
  * detected after the flight (UINT64_MAX when it ended otherwise). */
 static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm, bool truncated)
 {
+    uint64_t land_idx = UINT64_MAX;  /* first sample after the flight */
     gs_fit_result r;
     double dt = frame_dt(f);
     if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
@@ -618,6 +640,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
     const gs_sample *sf = at(f, in_lo), *sl = at(f, in_hi);
     if (!sf || !sl || in_hi < in_lo) goto done;
+    land_idx = in_hi + 1;
     uint32_t count = (uint32_t)(in_hi - in_lo + 1);
     gs_fit_result fr;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
@@ -727,7 +750,10 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     emit(f, &ev);
 
 done:
+    /* the next flight may start right after this landing: its take-off side must
+     * see the contact samples that follow it */
     f->quiet_from = newest;
+    if (land_idx != UINT64_MAX && land_idx < newest) f->quiet_from = land_idx;
     {
         /* next seeds start after the landing: restart the level trackers */
         const gs_sample *s = at(f, newest);
@@ -744,19 +770,30 @@ done:
 
 static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s);
 
-static void update_standing(gs_flight *f, const gs_sample *s, double u)
+/* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
+static double speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample *s, double u)
 {
-    /* speed over at least 0.1 s, so that keypoint jitter at high frame rates is not motion */
-    if (!isfinite(f->lag_t) || s->t_s < f->lag_t) { f->lag_t = s->t_s; f->lag_u = u; return; }
-    double span = s->t_s - f->lag_t;
-    if (span < 0.1) return;
-    double speed = fabs(u - f->lag_u) / span;
-    f->lag_t = s->t_s;
-    f->lag_u = u;
+    uint64_t k = (uint64_t)ceil(0.1 / frame_dt(f));
+    if (k < 1) k = 1;
+    if (idx < gs_ring_oldest(f->ring) + k) return NAN;
+    const gs_sample *b = at(f, idx - k);
+    if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
+    return fabs(u - u_of(f, b)) / (s->t_s - b->t_s);
+}
+
+static void update_standing(gs_flight *f, const gs_sample *s, double speed)
+{
+    if (!isfinite(speed)) return;
     if (f->rigid || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
-    bool still = speed < STAND_SPEED_REL * (double)s->size_px && s->upright >= STAND_UPRIGHT;
-    if (!still) { f->still_since = NAN; return; }
+    /* stillness is broken by motion only; uprightness is judged frame by frame */
+    if (!(speed < STAND_SPEED_REL * (double)s->size_px)) { f->still_since = NAN; return; }
     if (!isfinite(f->still_since)) f->still_since = s->t_s;
+    if (s->upright >= LOOSE_UPRIGHT) {
+        f->loose_size[f->loose_next] = s->size_px;
+        f->loose_next = (f->loose_next + 1u) % GS_STAND_KEEP;
+        if (f->loose_n < GS_STAND_KEEP) f->loose_n++;
+    }
+    if (!(s->upright >= STAND_UPRIGHT)) return;
     if (s->t_s - f->still_since < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
     f->stand_size[f->stand_next] = s->size_px;
     f->stand_next = (f->stand_next + 1u) % GS_STAND_KEEP;
@@ -764,9 +801,9 @@ static void update_standing(gs_flight *f, const gs_sample *s, double u)
     f->stand_last_t = s->t_s;
     /* body axis -> image up, until flights measure gravity directly */
     if (!f->up_from_flight && isfinite(s->up_x) && isfinite(s->up_y)) {
-        double k = f->up_n < 20 ? 1.0 / (double)(f->up_n + 1) : 0.05;
-        double ux = (1.0 - k) * f->up_x + k * (double)s->up_x;
-        double uy = (1.0 - k) * f->up_y + k * (double)s->up_y;
+        double kw = f->up_n < 20 ? 1.0 / (double)(f->up_n + 1) : 0.05;
+        double ux = (1.0 - kw) * f->up_x + kw * (double)s->up_x;
+        double uy = (1.0 - kw) * f->up_y + kw * (double)s->up_y;
         if (f->up_n == 0) { ux = s->up_x; uy = s->up_y; }
         double nrm = sqrt(ux * ux + uy * uy);
         if (nrm > 0.0) { f->up_x = ux / nrm; f->up_y = uy / nrm; }
@@ -804,6 +841,11 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     double d2 = f->u_hist[2] - 2.0 * f->u_hist[1] + f->u_hist[0];
     double sz = size_ref(f, s);
 
+    /* keypoint noise, not motion: judged while nearly still (contact phases of a
+     * jump series would otherwise pass for noise) */
+    double speed = speed_px_s(f, idx, s, f->u_hist[2]);
+    double sz_now = size_ref(f, s);
+    bool still = isfinite(speed) && (!isfinite(sz_now) || speed < STAND_SPEED_REL * sz_now);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
@@ -815,12 +857,12 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
             f->noise_px = med / 1.652;  /* median |N(0, 6 s^2)| = 1.652 s */
             if (f->noise_px < 0.05) f->noise_px = 0.05;
         }
-    } else {
+    } else if (still) {
         double a = fabs(d2) / 1.954;  /* E|N(0, 6 s^2)| = 1.954 s */
         if (a > 3.0 * f->noise_px) a = 3.0 * f->noise_px;
         f->noise_px += 0.02 * (a - f->noise_px);
     }
-    update_standing(f, s, f->u_hist[2]);
+    update_standing(f, s, speed);
 
     /* recent minimum over two half-second blocks */
     if (!isfinite(f->blk_t0)) f->blk_t0 = tm;
@@ -835,26 +877,27 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     double nz = noise_floor(f);
     double thr = SEED_RISE_NOISE * nz;
     if (isfinite(sz) && SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;
-    if (um - umin > thr) {
-        if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; }
-        else {
-            double drop = SEED_DROP_NOISE * nz;
-            if (isfinite(sz) && 0.01 * sz > drop) drop = 0.01 * sz;
-            if (f->peak_u - um > drop) {
-                if (seed_core(f, f->peak_idx, idx)) {
-                    set_state(f, GS_FS_AIRBORNE, f->peak_t);
-                    /* samples after the core that arrived meanwhile are tested in order */
-                    for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
-                        const gs_sample *p = at(f, i);
-                        if (usable(p)) airborne_sample(f, i, p);
-                    }
-                } else {
-                    f->peak_u = -INFINITY;
-                }
-            }
+    DBG("g t=%.3f um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", tm, um, umin, thr, nz, sz, f->peak_u);
+    /* a peak counts once it rose thr above the recent minimum; the drop that
+     * confirms it as an apex seeds a flight, however far it has fallen by then */
+    if (!isfinite(f->peak_u)) {
+        if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; }
+        return;
+    }
+    if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; return; }
+    double drop = SEED_DROP_NOISE * nz;
+    if (isfinite(sz) && 0.01 * sz > drop) drop = 0.01 * sz;
+    if (f->peak_u - um <= drop) return;
+    uint64_t apex = f->peak_idx;
+    double apex_t = f->peak_t;
+    f->peak_u = -INFINITY;
+    if (seed_core(f, apex, idx)) {
+        set_state(f, GS_FS_AIRBORNE, apex_t);
+        /* samples after the core that arrived meanwhile are tested in order */
+        for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
+            const gs_sample *p = at(f, i);
+            if (usable(p)) airborne_sample(f, i, p);
         }
-    } else {
-        f->peak_u = -INFINITY;
     }
 }
 
@@ -880,6 +923,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
         land(f, idx, UINT64_MAX, s);
         return;
     }
+    uint64_t k = idx - f->fl_last - 1;  /* position among the pending samples */
+    if (k >= 32) { land(f, idx, UINT64_MAX, s); return; }
     double z;
     bool ok = test_sample(f, &f->fit, &r, s, &z);
     DBG("t=%.4f ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", s->t_s, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
@@ -891,15 +936,25 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     f->cusum = cusum_step(f->cusum, z);
     if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
         if (alarm_is_false(f, f->fl_first, idx, idx, +1)) {
-            f->fl_last = idx;
+            f->fl_last = idx;   /* the refit took every sample through idx */
             f->cusum = 0.0;
+            f->pend_ok = 0;
             return;
         }
         land(f, idx, idx, s);
         return;
     }
-    gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
-    if (f->cusum == 0.0) f->fl_last = idx;
+    f->pend_ok |= 1u << k;
+    if (f->cusum == 0.0) {
+        /* everything pending was flight after all: take it in */
+        for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
+            const gs_sample *p = at(f, j);
+            if (usable(p) && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
+                gs_fit_add(&f->fit, p->t_s, p->x_px, p->y_px, p->w);
+        }
+        f->fl_last = idx;
+        f->pend_ok = 0;
+    }
 }
 
 void gs_flight_update(gs_flight *f)

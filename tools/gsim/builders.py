@@ -75,7 +75,7 @@ class Builder:
         self.t = t1
         self.check(t0, t1, 0.05)
 
-    def check(self, t0, t1, dt=0.04):
+    def check(self, t0, t1, dt=0.1):
         t = t0
         while t <= t1:
             st = self.m.state(t)   # raises Infeasible if the contact solve fails
@@ -92,7 +92,10 @@ class Builder:
         m = self.m
         ph = m.phases[-1]
         self.pin(t0)
+        m.clamped = False
         x0, xr = m.solved_rates(t0)
+        if m.clamped:
+            raise Infeasible("take-off on a clamped contact")
         c0 = m.state(t0)[1]
         v0 = (vxy[0], vxy[1], v0z)
         ph.t1 = t0
@@ -219,7 +222,7 @@ class Builder:
         t_down = u(0.40, 0.65) * (0.6 + dip / 0.4)
         tb = ta + t_down
         zb = self.z_st - dip
-        ab = u(0.5, 1.3) * G
+        ab = min(u(0.5, 1.3) * G, 4.0 * dip / t_down ** 2)
         sym = kind != "funny"
         arm_back = -u(35, 75) * D2R
         arm_to = (u(100, 165) if kind != "low" else u(20, 100)) * D2R
@@ -296,7 +299,8 @@ class Builder:
         t_abs = max(0.12, (zL - z_abs) / abs(vL) * u(1.7, 2.3))
         tc = tL + t_abs
         td = tc + u(0.5, 0.9)
-        ac = u(0.3, 1.0) * G
+        # bounded so the rise back to standing does not overshoot the standing height
+        ac = min(u(0.3, 1.0) * G, 4.0 * (self.z_st - z_abs) / (td - tc) ** 2)
         m.z.add_quintic(tL, tc, zL, vL, u(1.5, 4.0) * G, z_abs, 0.0, ac)
         m.z.add_quintic(tc, td, z_abs, 0.0, ac, self.z_st, 0.0, 0.0)
         dmid = (self.dbal[0] + g(0, 0.01), self.dbal[1] + g(0, 0.01))
@@ -380,7 +384,8 @@ class Builder:
         t_abs = max(0.12, (zL - z_abs) / abs(vL) * u(1.7, 2.3))
         tc = tL + t_abs
         td = tc + u(0.4, 0.8)
-        ac = u(0.3, 1.0) * G
+        # bounded so the rise back to standing does not overshoot the standing height
+        ac = min(u(0.3, 1.0) * G, 4.0 * (self.z_st - z_abs) / (td - tc) ** 2)
         m.z.add_quintic(tL, tc, zL, vL, u(1.5, 3.0) * G, z_abs, 0.0, ac)
         m.z.add_quintic(tc, td, z_abs, 0.0, ac, self.z_st, 0.0, 0.0)
         self.hpiece(c, tL, td, dL, vLxy, self.dbal, (0, 0))
@@ -586,7 +591,7 @@ class Builder:
         vxy = (direction * v, self.rng.gauss(0, 0.03))
         m.z.add_quintic(ta, t0, za, va, aa, z_to, vz, u(-0.6, -0.2) * G)
         self.hpiece(c, ta, t0, da, vda, (dx, dy), vxy)
-        self.check(ta, t0, 0.02)
+        self.check(ta, t0, 0.05)
         return z_to, vz, vxy
 
 

@@ -162,6 +162,14 @@ PRESETS = {
 }
 
 
+def draw_roll(rng, rng_range):
+    """A fixed roll is used as given; a range lo:hi draws |roll| in it with a random sign."""
+    lo, hi = rng_range
+    if lo == hi:
+        return float(lo)
+    return round(rng.uniform(lo, hi) * (1 if rng.random() < 0.5 else -1), 3)
+
+
 def plan(opts):
     """Trial specs for a dataset. opts: dict of CLI options (see tools/gen_jumps.py)."""
     rng = random.Random("plan/%s" % opts["seed"])
@@ -175,9 +183,7 @@ def plan(opts):
             for jt in types:
                 ntr = opts["trials"] if jt not in opts.get("extra", []) else 1
                 for tr in range(1, ntr + 1):
-                    rlo, rhi = opts["roll"]
-                    roll = round(rng.uniform(rlo, rhi) * (1 if rng.random() < 0.5 else -1), 3) \
-                        if rhi > 0 else 0.0
+                    roll = draw_roll(rng, opts["roll"])
                     specs.append({"trial": "%s_d%g_%s_t%d" % (sid, d, jt, tr), "subject": sid,
                                   "stature_m": H, "distance_m": d, "jump_type": jt,
                                   "fps": opts["fps"], "res": opts["res"], "roll_deg": roll,
@@ -188,8 +194,8 @@ def plan(opts):
                     continue
                 specs.append({"trial": "%s_d%g_%s_t1" % (sid, d, jt), "subject": sid,
                               "stature_m": H, "distance_m": d, "jump_type": jt,
-                              "fps": opts["fps"], "res": opts["res"], "roll_deg": 0.0 if
-                              opts["roll"][1] == 0 else round(rng.uniform(*opts["roll"]), 3),
+                              "fps": opts["fps"], "res": opts["res"],
+                              "roll_deg": draw_roll(rng, opts["roll"]),
                               "noise": opts["noise"], "seed": opts["seed"],
                               "distortion": opts.get("distortion", False)})
     return specs

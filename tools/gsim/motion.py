@@ -17,6 +17,9 @@ from .track import Track, ZPath
 
 G = 9.81
 D2R = math.pi / 180.0
+CLAMP_V = 0.25   # m/s: slowest designed vertical COM speed where the reach clamp may act
+CLAMP_DZ = 0.02  # m: largest allowed clamp
+CLAMP_S = 0.02   # support flexion used while clamped
 S_LO, S_HI = 0.0, 1.45   # admissible support-leg flexion (no hyperextension)
 
 
@@ -84,6 +87,7 @@ class Motion:
         self.phases = []          # Contact / Flight, in time order
         self.path = None          # walk: function t -> (x, y) of the root
         self._s = 0.06
+        self.clamped = False
 
     # ---- pose --------------------------------------------------------------
     def pose(self, t):
@@ -149,11 +153,14 @@ class Motion:
         ry /= len(refs)
         return (wc[2] - low, wc[0] - rx, wc[1] - ry)
 
-    def _solve(self, p, ph, t, retry=True):
+    def _solve(self, p, ph, t, retry=True, zcap=None):
         """Solve support flexion and the two horizontal channels so the COM is on its design."""
         pu, mu, _ = body.upper(self.sub, p)
         Ry = body.rz(p["yaw"])
-        target = (self.z.eval(t)[0], ph.hx.eval(t)[0], ph.hy.eval(t)[0])
+        zd, vzd, _ = self.z.eval(t)
+        if zcap is not None:
+            zd = min(zd, zcap)
+        target = (zd, ph.hx.eval(t)[0], ph.hy.eval(t)[0])
         x = list(ph.u) if ph.u is not None else [self._s, p[ph.solve[0]], p[ph.solve[1]]]
         x0 = list(x)
 
@@ -199,7 +206,28 @@ class Motion:
             # Hc(s) peaks at s = 0: restart on the flexed branch
             ph.u = [0.3, x0[1], x0[2]]
             ph.J = None
-            return self._solve(p, ph, t, retry=False)
+            try:
+                return self._solve(p, ph, t, retry=False, zcap=zcap)
+            except Infeasible:
+                if zcap is not None or abs(vzd) > CLAMP_V:
+                    raise
+            # slow phase (quiet standing, late recovery): the design asks for a COM a little
+            # higher than straight legs allow; keep the legs straight-ish instead of failing
+            cap = zd
+            for _ in range(6):
+                r = self._resid(p, ph, Ry, pu, mu, (CLAMP_S, x0[1], x0[2]))
+                cap = r[0] - 1e-6
+                if zd - cap > CLAMP_DZ:
+                    raise Infeasible("COM design %.4f m above reach" % (zd - cap))
+                ph.u = [CLAMP_S + 0.02, x0[1], x0[2]]
+                ph.J = None
+                try:
+                    x = self._solve(p, ph, t, retry=False, zcap=cap)
+                    self.clamped = True
+                    return x
+                except Infeasible:
+                    continue
+            raise Infeasible("clamp failed")
         if max(abs(v) for v in f) > 1e-9 or not (S_LO <= x[0] <= S_HI) \
                 or abs(x[1]) > 1.2 or abs(x[2]) > 1.2:
             raise Infeasible("contact solve failed at t=%.4f: %r %r" % (t, x, f))
