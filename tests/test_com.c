@@ -379,12 +379,13 @@ static void test_weight_tracks_confidence(void)
     double kept = 1 - 0.5 * (mt + ms + mf);
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, kept * kept * 0.9, o.w);
     /* Both knees lost: nothing to mirror from, so both thighs and shanks are
-     * dropped and the rest renormalised; the feet sit at the ankles, counted half. */
+     * dropped and the rest renormalised; the feet sit at the ankles, counted half.
+     * A COM that lacks whole segments is biased, so the frame nearly drops out (x 0.02). */
     project(b, lat, GS_LAYOUT_COCO17, kp);
     kp[13].c = kp[14].c = 0.0f;
     o = run(GS_LAYOUT_COCO17, GS_MASS_DELEVA, GS_STATURE_ANTHRO, kp);
     kept = 1 - 2 * (mt + ms + 0.5 * mf);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-4, kept * kept * 0.9, o.w);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, kept * kept * 0.9 * 0.02, o.w);
 }
 
 static void test_mass_tables(void)

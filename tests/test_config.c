@@ -199,7 +199,7 @@ void test_good_syntax_variants(void)
     TEST_ASSERT_EQUAL_INT(GS_OK, parse("", 0, &err));
     TEST_ASSERT_EQUAL_INT(GS_OK, parse(NULL, 0, &err));
     TEST_ASSERT_EQUAL_INT(GS_OK, parse_str("\n\n# x\n   \n\r\n", &err));
-    TEST_ASSERT_EQUAL_FLOAT(0.3f, g_core.min_conf);
+    TEST_ASSERT_EQUAL_FLOAT(0.1f, g_core.min_conf);
     /* routing to the other section's handler, value with '#' not after a blank */
     TEST_ASSERT_EQUAL_INT(GS_OK, parse_str("[sink]\npath = /tmp/a#b.jsonl  # out\n", &err));
     TEST_ASSERT_EQUAL_INT(1, g_sink.n_calls);
@@ -267,7 +267,7 @@ void test_defaults_and_check(void)
     TEST_ASSERT_EQUAL_DOUBLE(0.0, c.altitude_m);
     TEST_ASSERT_EQUAL_INT(GS_MASS_DELEVA, c.mass_table);
     TEST_ASSERT_EQUAL_INT(GS_STATURE_ANTHRO, c.stature);
-    TEST_ASSERT_EQUAL_FLOAT(0.3f, c.min_conf);
+    TEST_ASSERT_EQUAL_FLOAT(0.1f, c.min_conf);
     TEST_ASSERT_EQUAL_INT(GS_FIT_IRLS, c.fit_method);
     TEST_ASSERT_EQUAL_UINT32(512, c.ring_capacity);
     TEST_ASSERT_EQUAL_FLOAT(0.12f, c.min_flight_s);

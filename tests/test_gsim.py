@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.join(ROOT, "tools"))
 
 from gsim import anthro, body, builders, dataset, detector  # noqa: E402
 from gsim.camera import Camera  # noqa: E402
-from gsim.motion import Contact, Flight, G, Infeasible  # noqa: E402
+from gsim.motion import Flight, G, Infeasible  # noqa: E402
 
 
 def build(jtype, seed, stature=1.75):

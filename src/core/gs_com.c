@@ -6,6 +6,8 @@
 
 #include "gravscale/gs_com.h"
 
+#define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
+
 /* ---- canonical keypoints (COCO-17 order first, BlazePose extras after) ---- */
 
 enum {
@@ -622,6 +624,10 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
     }
     float frac = f.m_obs / total;
     float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
+    /* a segment missing outright (not even rebuilt from its mirror, e.g. the head
+     * out of the frame at the apex) biases the renormalised COM by centimetres:
+     * such frames count only when nothing better exists */
+    if (f.m_sum < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
     out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
     if (!isfinite(out->x_px) || !isfinite(out->y_px)) {
         out->x_px = out->y_px = NAN;

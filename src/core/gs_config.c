@@ -266,7 +266,7 @@ void gs_core_config_default(gs_core_config *c)
     c->altitude_m = 0.0;
     c->mass_table = GS_MASS_DELEVA;
     c->stature = GS_STATURE_ANTHRO;
-    c->min_conf = 0.3f;
+    c->min_conf = 0.1f;  /* blurred fast limbs come with low confidence but usable positions */
     c->fit_method = GS_FIT_IRLS;
     c->ring_capacity = 512u;
     c->min_flight_s = 0.12f;

@@ -903,7 +903,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
 
 static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample *s)
 {
-    /* the running fit saw samples past the edge: rebuild it over the clean range */
+    /* the running fit may hold samples past the edge: rebuild it over the flight */
     refit_range(f, f->fl_first, f->fl_last);
     close_candidate(f, idx, alarm, false);
     set_state(f, GS_FS_GROUND, s->t_s);
