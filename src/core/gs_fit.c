@@ -13,7 +13,7 @@
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
 #define GS_FIT_MAD_K 1.4826
 /* Bounded work for the robust starts: at most this many sample triples. */
-#define GS_FIT_TRIPLES 200u
+#define GS_FIT_TRIPLES 60u  /* all-inlier triple among 60 fails with p < 1e-6 at 40 % gross outliers */
 /* IRLS stops after this many reweightings even if the weights still move. */
 #define GS_FIT_IRLS_MAX_ITER 10
 /* Fixed PRNG seeds keep every robust fit reproducible. */
@@ -454,15 +454,14 @@ static double par_max_shift_px(const gs_par *a, const gs_par *b)
     return worst;
 }
 
-static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+/* Tukey biweight IRLS from a start; *fin receives the converged curve. */
+static gs_status irls_from(const gs_win *wn, gs_par cur, double floor_px, float *scratch_w,
+                           gs_fit_result *out, gs_par *fin)
 {
-    gs_par cur, next;
+    gs_par next;
     double med, scale;
     int it;
     gs_status st;
-    if (!lmeds_start(wn, m, scratch_w, &cur, &med)) {
-        return GS_EINVAL;
-    }
     for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
         med = median_resid(wn, &cur, scratch_w);
         /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
@@ -476,9 +475,58 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, float *
         }
         /* Settled when the curve moves by far less than the noise. */
         if (par_max_shift_px(&cur, &next) <= 1e-6 * scale) {
+            cur = next;
             break;
         }
         cur = next;
+    }
+    *fin = cur;
+    return GS_OK;
+}
+
+/* Robust loss of a curve: prior-weighted Tukey rho at the noise floor's cut-off
+ * (1 for a rejected sample), comparable between two candidate solutions. */
+static double tukey_loss(const gs_win *wn, const gs_par *p, double floor_px)
+{
+    double cut = GS_FIT_TUKEY_C * floor_px, loss = 0.0;
+    uint32_t i;
+    for (i = 0; i < wn->count; i++) {
+        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+        double u;
+        if (!sample_usable(s)) {
+            continue;
+        }
+        u = sqrt(resid2(p, win_tau(wn, s), s)) / cut;
+        loss += (double)s->w * (u < 1.0 ? 1.0 - (1.0 - u * u) * (1.0 - u * u) * (1.0 - u * u) : 1.0);
+    }
+    return loss;
+}
+
+/* IRLS from two starts, the least-median-of-squares one (survives many gross
+ * outliers) and the plain weighted fit (on clean data a few samples can fit a
+ * chance subset better than all of them): the smaller robust loss wins. */
+static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+{
+    gs_par lms, plain, fin_lms, fin_plain;
+    double med;
+    bool have_lms = lmeds_start(wn, m, scratch_w, &lms, &med);
+    bool have_plain = window_fit(wn, NULL, W_PRIOR, 0.0, scratch_w, &plain, out) == GS_OK;
+    double loss_lms = (double)INFINITY, loss_plain = (double)INFINITY;
+    if (!have_lms && !have_plain) {
+        return GS_EINVAL;
+    }
+    if (have_lms && irls_from(wn, lms, floor_px, scratch_w, out, &fin_lms) == GS_OK) {
+        loss_lms = tukey_loss(wn, &fin_lms, floor_px);
+    }
+    if (have_plain && irls_from(wn, plain, floor_px, scratch_w, out, &fin_plain) == GS_OK) {
+        loss_plain = tukey_loss(wn, &fin_plain, floor_px);
+    }
+    if (!(loss_plain <= loss_lms)) {
+        if (!(loss_lms < (double)INFINITY)) {
+            return GS_EINVAL;
+        }
+        /* the LMS run won: run it again so scratch_w and out hold its weights */
+        return irls_from(wn, lms, floor_px, scratch_w, out, &fin_lms);
     }
     return GS_OK;
 }

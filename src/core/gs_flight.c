@@ -934,6 +934,12 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     }
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
+    /* deviations that persist for the configured latency end the flight, alarm or not */
+    const gs_sample *edge = at(f, f->fl_last);
+    if (f->cusum > 0.0 && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
+        land(f, idx, idx, s);
+        return;
+    }
     if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
         if (alarm_is_false(f, f->fl_first, idx, idx, +1)) {
             f->fl_last = idx;   /* the refit took every sample through idx */
