@@ -22,7 +22,7 @@
 #endif
 
 /* tuning: thresholds in units of the noise or of the object's size */
-#define SEED_RISE_REL    0.05   /* apex must rise this x size above the recent minimum */
+#define SEED_RISE_REL    0.03   /* apex must rise this x size above the recent minimum */
 #define SEED_RISE_NOISE  8.0    /* ... and this x noise */
 #define SEED_DROP_NOISE  2.5    /* apex confirmed once u fell this x noise below it */
 #define CORE_HALF_S      0.07   /* half-width of the seed's core window */
