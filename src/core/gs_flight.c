@@ -41,6 +41,7 @@
 #define STAND_SPEED_REL  0.25   /* standing: |du/dt| below this x size per second */
 #define STAND_UPRIGHT    0.7
 #define LOOSE_UPRIGHT    0.5    /* fallback size samples (no settled stance seen yet) */
+#define MEDIAN_MAX       64     /* largest set a median is taken of */
 #define NOISE_INIT_N     9      /* second differences whose median starts the noise estimate */
 #define STAND_SETTLE_S   0.2    /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      2.0    /* candidates implying a size beyond [min/2, max*2] are not flights */
@@ -453,9 +454,11 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
 
 /* ---- closing a candidate ---------------------------------------------------- */
 
+/* median of n <= MEDIAN_MAX values and its standard error (from the MAD) */
 static double median_se(const float *v, uint32_t n, double *se_out)
 {
-    float tmp[GS_STAND_KEEP], dev[GS_STAND_KEEP];
+    float tmp[MEDIAN_MAX], dev[MEDIAN_MAX];
+    if (n > MEDIAN_MAX) n = MEDIAN_MAX;
     for (uint32_t i = 0; i < n; i++) tmp[i] = v[i];
     double med = median_f(tmp, n);
     if (n >= 2) {
@@ -479,22 +482,14 @@ static double stand_size(const gs_flight *f, double *se_out)
 
 static double rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, double *se_out)
 {
-    float tmp[64], dev[64];
+    float v[MEDIAN_MAX];
     uint32_t n = 0;
-    uint64_t step = (hi - lo + 1 + 63) / 64;
-    if (step == 0) step = 1;
-    for (uint64_t i = lo; i <= hi && n < 64; i += step) {
+    uint64_t step = (hi - lo + MEDIAN_MAX) / MEDIAN_MAX;
+    for (uint64_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
         const gs_sample *s = at(f, i);
-        if (s && isfinite(s->size_px) && s->size_px > 0.0f) tmp[n++] = s->size_px;
+        if (s && isfinite(s->size_px) && s->size_px > 0.0f) v[n++] = s->size_px;
     }
-    double med = median_f(tmp, n);
-    if (n >= 2) {
-        for (uint32_t i = 0; i < n; i++) dev[i] = (float)fabs((double)tmp[i] - med);
-        *se_out = 1.2533 * median_f(dev, n) * 1.4826 / sqrt((double)n);
-    } else {
-        *se_out = NAN;
-    }
-    return med;
+    return median_se(v, n, se_out);
 }
 
 /* Grow the flight backwards in time from the core with the same CUSUM test.

@@ -127,8 +127,8 @@ bool gs_kp_json_track(gs_jlex *lex, const gs_jtok *v, const char *path, uint32_t
     return true;
 }
 
-/* Frame index from an image name: its last run of digits ("000123.jpg" -> 123). */
-static bool index_from_name(const char *s, size_t n, uint64_t *out)
+/* Frame index from a file or image name: its last run of digits ("000123.jpg" -> 123). */
+bool gs_kp_index_from_name(const char *s, size_t n, uint64_t *out)
 {
     size_t e = n;
     while (e > 0 && !(s[e - 1] >= '0' && s[e - 1] <= '9'))
@@ -168,7 +168,7 @@ static bool parse_person(gs_jlex *lex, const gs_jtok *obj, const char *path, gs_
         }
         if (gs_jtok_eq(&t, "image_id")) {
             if (v.type == GS_JT_STR) {
-                if (!index_from_name(v.s, v.len, &p->frame)) {
+                if (!gs_kp_index_from_name(v.s, v.len, &p->frame)) {
                     gs_kpread_fail(err, GS_KPR_EDATA, path, obj->line, "image_id",
                                    "no frame number in '%.*s'", (int)(v.len > 40 ? 40 : v.len),
                                    v.s);

@@ -30,25 +30,6 @@ static int file_cmp(const void *a, const void *b)
     return strcmp(x->name, y->name);
 }
 
-/* The last run of digits of a name (without the suffix). */
-static bool name_index(const char *s, size_t n, uint64_t *out)
-{
-    size_t e = n;
-    while (e > 0 && !(s[e - 1] >= '0' && s[e - 1] <= '9'))
-        e--;
-    if (e == 0)
-        return false;
-    size_t b = e;
-    while (b > 0 && s[b - 1] >= '0' && s[b - 1] <= '9')
-        b--;
-    if (e - b > 15)
-        return false;
-    uint64_t v = 0;
-    for (size_t i = b; i < e; i++)
-        v = v * 10 + (uint64_t)(s[i] - '0');
-    *out = v;
-    return true;
-}
 
 static bool parse_person(gs_jlex *lex, const gs_jtok *obj, const char *path, uint64_t frame,
                          gs_kp_people *people, gs_kpread_error *err)
@@ -219,7 +200,7 @@ bool gs_kp_openpose_load(const char *dir, gs_kp_people *people, gs_kpread_error 
         if (nl <= sl || strcmp(e->d_name + nl - sl, SUFFIX) != 0)
             continue;
         uint64_t idx;
-        if (!name_index(e->d_name, nl - sl, &idx)) {
+        if (!gs_kp_index_from_name(e->d_name, nl - sl, &idx)) {
             gs_kpread_fail(err, GS_KPR_EDATA, dir, 0, NULL, "no frame number in the name '%s'",
                            e->d_name);
             goto out;

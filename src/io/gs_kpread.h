@@ -113,6 +113,9 @@ bool gs_kp_json_track(gs_jlex *lex, const gs_jtok *v, const char *path, uint32_t
                       const char *key, long *track, gs_kpread_error *err);
 
 /* The OpenPose -> COCO-17 maps (index into the source layout for each COCO-17 keypoint). */
+/* Frame index from a file or image name: its last run of digits ("000123.jpg" -> 123). */
+bool gs_kp_index_from_name(const char *s, size_t n, uint64_t *out);
+
 extern const uint8_t gs_kp_body25_to_coco17[17];
 extern const uint8_t gs_kp_coco18_to_coco17[17];
 
