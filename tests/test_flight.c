@@ -287,6 +287,7 @@ static void test_time_gaps(void)
     capture cap;
     memset(&cap, 0, sizeof cap);
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    gs_pipeline_set_track(&p, 7);  /* every event must carry its object's number */
     for (long i = 0; i < 300; i++) {
         if (i % 10 == 7) continue;  /* a dropped frame: its timestamp is simply absent */
         double t = i / 30.0;
@@ -299,6 +300,8 @@ static void test_time_gaps(void)
     TEST_ASSERT_EQUAL_INT(3, match(&s, &cap, map));
     for (int k = 0; k < 3; k++)
         TEST_ASSERT_DOUBLE_WITHIN(0.005 * 3270.0, 3270.0, cap.jumps[map[k]].a_px_s2);
+    for (int e = 0; e < cap.n_jumps; e++) TEST_ASSERT_EQUAL_UINT32(7, cap.jumps[e].track);
+    TEST_ASSERT_EQUAL_UINT32(7, cap.summary.track);
 }
 
 static void test_bad_calls(void)

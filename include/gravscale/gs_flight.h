@@ -30,6 +30,7 @@ typedef struct {
     void *ctx;
     bool trace;
     bool rigid;                /* object size is measured in every frame (ball), not while standing */
+    uint32_t track;            /* reported in every event (several objects: one pipeline each) */
     double g_m_s2;
 
     gs_flight_state state;

@@ -30,6 +30,9 @@ size_t gs_pipeline_storage_bytes(const gs_core_config *cfg);
 gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout layout,
                            void *storage, size_t storage_bytes,
                            gs_event_fn on_event, void *ctx);
+/* Number this pipeline's object: every jump/height/summary event carries it
+ * (one pipeline per tracked object when several are followed). Default 0. */
+void gs_pipeline_set_track(gs_pipeline *p, uint32_t track);
 /* Also emit GS_EV_STATE / GS_EV_SAMPLE / GS_EV_FIT trace events. */
 void gs_pipeline_set_trace(gs_pipeline *p, bool on);
 

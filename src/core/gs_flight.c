@@ -664,6 +664,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     ev.type = GS_EV_JUMP;
     gs_ev_jump *j = &ev.u.jump;
     j->index = f->n_flights;
+    j->track = f->track;
     j->t_takeoff_s = T0;
     j->t_land_s = T1;
     j->flight_time_s = T1 - T0;

@@ -57,6 +57,11 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
                           on_flight_event, p);
 }
 
+void gs_pipeline_set_track(gs_pipeline *p, uint32_t track)
+{
+    if (p) p->flight.track = track;
+}
+
 void gs_pipeline_set_trace(gs_pipeline *p, bool on)
 {
     if (p) p->flight.trace = on;
@@ -135,6 +140,7 @@ gs_status gs_pipeline_flush(gs_pipeline *p)
     memset(&ev, 0, sizeof ev);
     ev.type = GS_EV_SUMMARY;
     gs_agg_get(&p->agg, &ev.u.height);
+    ev.u.height.track = p->flight.track;
     if (p->on_event) p->on_event(p->ctx, &ev);
     return GS_OK;
 }
