@@ -26,7 +26,7 @@
 #define SEED_RISE_NOISE  8.0    /* ... and this x noise */
 #define SEED_DROP_NOISE  2.5    /* apex confirmed once u fell this x noise below it */
 #define CORE_HALF_S      0.07   /* half-width of the seed's core window */
-#define CUSUM_K          1.5    /* CUSUM reference: deviations below k sigma drain it */
+#define CUSUM_K          1.3    /* CUSUM reference: deviations below k sigma drain it */
 #define CUSUM_H          5.0    /* CUSUM alarm: contact */
 #define VERIFY_Z         2.0    /* after a refit through an alarm, edge samples below this: false alarm */
 #define CUSUM_ZMAX       6.0    /* one sample adds at most this (a lone glitch cannot end a flight) */
