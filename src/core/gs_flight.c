@@ -28,6 +28,7 @@
 #define CORE_HALF_S      0.07   /* half-width of the seed's core window */
 #define CUSUM_K          1.3    /* CUSUM reference: deviations below k sigma drain it */
 #define CUSUM_H          5.0    /* CUSUM alarm: contact */
+#define VERIFY_RMS       2.5    /* ... and only when the refit's residual is near the noise */
 #define VERIFY_Z         2.0    /* after a refit through an alarm, edge samples below this: false alarm */
 #define CUSUM_ZMAX       6.0    /* one sample adds at most this (a lone glitch cannot end a flight) */
 #define BOUNDARY_IN_S    0.025  /* boundary search reaches this far (at least a frame) inside the grown flight */
@@ -290,6 +291,8 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
     if (gs_fit_solve(&f->fit, &r) != GS_OK) return false;
+    /* a refit that only fits with a residual far above the noise proves nothing */
+    if (r.rms_px / sqrt(2.0) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
         const gs_sample *s = at(f, i);
@@ -324,7 +327,11 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     }
     if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
-    if (gs_fit_solve(&f->fit, &r) != GS_OK || !plausible_fall(f, &r, gate_size(f, apex))) {
+    uint32_t n_usable = 0;
+    for (uint64_t i = lo; i <= hi; i++) n_usable += usable(at(f, i)) ? 1u : 0u;
+    /* a core the robust fit had to cut down to a few samples is not a curve yet */
+    bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
+    if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
         DBG("seed at %.4f (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", at(f, apex)->t_s, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
         return false;
     }
