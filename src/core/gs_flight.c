@@ -22,6 +22,7 @@
 #endif
 
 /* tuning: thresholds in units of the noise or of the object's size */
+#define USABLE_W_MIN     0.05f  /* lighter frames are left out of flight detection */
 #define SEED_RISE_REL    0.03   /* apex must rise this x size above the recent minimum */
 #define SEED_RISE_NOISE  8.0    /* ... and this x noise */
 #define SEED_DROP_NOISE  2.5    /* apex confirmed once u fell this x noise below it */
@@ -49,9 +50,11 @@
 
 static const gs_sample *at(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i); }
 
+/* Frames that weigh almost nothing (the COM lacks a whole segment, e.g. the head
+ * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample *s)
 {
-    return s && s->w > 0.0f && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
+    return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
 }
 
 static double u_of(const gs_flight *f, const gs_sample *s)
@@ -974,7 +977,11 @@ void gs_flight_update(gs_flight *f)
     while (f->next < head) {
         uint64_t idx = f->next++;
         const gs_sample *s = at(f, idx);
-        if (!usable(s)) continue;
+        /* a gap is frames missing from the source; a light frame (the head out of
+         * the picture) is present, only not used */
+        bool present = s && s->w > 0.0f && isfinite(s->t_s);
+        if (present && !usable(s)) { f->last_t_s = s->t_s; continue; }
+        if (!present) continue;
         if (isfinite(f->last_t_s)) {
             double dt = s->t_s - f->last_t_s;
             if (dt > 0.0) {
