@@ -658,11 +658,12 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     double max_gap_in = 0.0, t_prev = NAN;
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         const gs_sample *s = at(f, i);
+        if (!s || !(s->w > 0.0f) || !isfinite(s->t_s)) continue;  /* frames missing from the source */
+        if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
+        t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
         if (st == GS_OK && !(f->scratch_w[i - in_lo] > 0.0f)) n_out++;
-        if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
-        t_prev = s->t_s;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
