@@ -304,6 +304,33 @@ static void test_time_gaps(void)
     TEST_ASSERT_EQUAL_UINT32(7, cap.summary.track);
 }
 
+/* A ring too small for the flights at 120 fps (64 samples = 0.53 s): flights are
+ * cut or dropped, never a crash or a read of evicted samples (run under ASan in CI). */
+static void test_ring_smaller_than_a_flight(void)
+{
+    sim_track s;
+    make_track(&s, 3, 1.5, 2.5, 2.4, 2.8);  /* 0.49-0.57 s flights */
+    gs_core_config cfg;
+    gs_core_config_default(&cfg);
+    cfg.ring_capacity = 64;
+    cfg.size_min_m = 0.01f;
+    static gs_pipeline p;
+    capture cap;
+    memset(&cap, 0, sizeof cap);
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    for (long i = 0; i < 1200; i++) {
+        double t = i / 120.0;
+        bool air;
+        double u = track_u(&s, t, &air);
+        TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, t, 500.0f, (float)(600.0 - u / 0.003), 1.0f, 66.7f));
+    }
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
+    TEST_ASSERT_EQUAL_INT(1, cap.n_summary);
+    /* whatever was accepted is still right */
+    for (int e = 0; e < cap.n_jumps; e++)
+        if (cap.jumps[e].accepted) TEST_ASSERT_DOUBLE_WITHIN(0.01 * 3270.0, 3270.0, cap.jumps[e].a_px_s2);
+}
+
 static void test_bad_calls(void)
 {
     gs_core_config cfg;
@@ -329,6 +356,7 @@ int main(void)
     RUN_TEST(test_120fps);
     RUN_TEST(test_no_flight);
     RUN_TEST(test_time_gaps);
+    RUN_TEST(test_ring_smaller_than_a_flight);
     RUN_TEST(test_bad_calls);
     return UNITY_END();
 }

@@ -335,7 +335,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
-        DBG("seed at %.4f (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", at(f, apex)->t_s, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
+        DBG("seed at %llu (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", (unsigned long long)apex, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
         return false;
     }
     f->fl_first = lo;
@@ -613,6 +613,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     if (left_alarm != UINT64_MAX) n_left = contact_run(f, &r, L, -1, &lo, &first_left);
     if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
     double T0 = NAN, T1 = NAN;
+    /* a flight longer than the ring holds has lost its edges: no refinement */
+    if (!at(f, L) || !at(f, R) || !at(f, lo) || !at(f, hi) || !at(f, first_left) || !at(f, first_right))
+        n_left = n_right = 0;
     double amin = CONTACT_MIN_G * r.a_px_s2;
     double sig = fit_sigma(f, &r);
     double pen = DROP_PENALTY * sig * sig;
@@ -626,8 +629,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, at(f, R)->t_s, pen, &r);
     else if (n_right == 1)
         T1 = 0.5 * (at(f, first_right)->t_s + at(f, R)->t_s);
-    DBG("close: L=%.4f R=%.4f lo=%.4f hi=%.4f nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
-        at(f, L)->t_s, at(f, R)->t_s, at(f, lo)->t_s, at(f, hi)->t_s, n_left, n_right, T0, T1, r.a_px_s2);
+    DBG("close: L=%llu R=%llu lo=%llu hi=%llu nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
+        (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
+        n_left, n_right, T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
     uint64_t in_lo = lo, in_hi = hi;
     while (in_lo < in_hi) {
