@@ -10,7 +10,8 @@ BUILD_DIR=${BUILD_DIR:-build}
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 
-pkgs=(build-essential cmake ninja-build python3 binutils)
+# OpenCV and libavformat for the video command (tests render clips with them)
+pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

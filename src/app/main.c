@@ -6,6 +6,10 @@
 
 /* Defined in cmd_replay.c (no app header yet: one prototype per side). */
 int gs_cmd_replay(int argc, char **argv);
+#if defined(GS_HAVE_VISION) && GS_HAVE_VISION
+/* Defined in cmd_video.cpp (C++, extern "C"). */
+int gs_cmd_video(int argc, char **argv);
+#endif
 
 static void usage(FILE *f)
 {
@@ -17,6 +21,8 @@ static void usage(FILE *f)
           "commands:\n"
           "  replay     read recorded keypoints (CSV, AlphaPose, OpenPose) and report\n"
           "             jumps and the height as JSON Lines or NMEA sentences\n"
+          "  video      detect a ball in a video file or an image sequence and report\n"
+          "             its flights and its diameter the same way\n"
           "\n"
           "options:\n"
           "  --help     this text\n"
@@ -44,6 +50,15 @@ int main(int argc, char **argv)
     }
     if (strcmp(cmd, "replay") == 0)
         return gs_cmd_replay(argc - 1, argv + 1);
+    if (strcmp(cmd, "video") == 0) {
+#if defined(GS_HAVE_VISION) && GS_HAVE_VISION
+        return gs_cmd_video(argc - 1, argv + 1);
+#else
+        fputs("gravscale: built without OpenCV: the video command is not available "
+              "(install libopencv-dev and libavformat-dev, then rebuild)\n", stderr);
+        return 2;
+#endif
+    }
     fprintf(stderr, "gravscale: unknown command '%s' (see gravscale --help)\n", cmd);
     return 2;
 }
