@@ -61,6 +61,25 @@ void gs_kp_json_syntax(const gs_jlex *lex, const char *path, gs_kpread_error *er
                    "invalid JSON: %s", lex->err);
 }
 
+bool gs_kp_json_begin(gs_jlex *lex, const char *text, size_t len, const char *path, gs_jt want,
+                      const char *what, gs_jtok *first, gs_kpread_error *err)
+{
+    gs_jlex_init(lex, text, len);
+    gs_jt k = gs_jlex_next(lex, first);
+    if (k == GS_JT_ERROR) {
+        if (len == 0)
+            gs_kpread_fail(err, GS_KPR_EDATA, path, 1, NULL, "empty file");
+        else
+            gs_kp_json_syntax(lex, path, err);
+        return false;
+    }
+    if (k != want) {
+        gs_kpread_fail(err, GS_KPR_EDATA, path, first->line, NULL, what);
+        return false;
+    }
+    return true;
+}
+
 bool gs_kp_json_numbers(gs_jlex *lex, const gs_jtok *v, const char *path, uint32_t obj_line,
                         const char *key, double *out, size_t cap, size_t *n, gs_kpread_error *err)
 {
@@ -233,22 +252,12 @@ bool gs_kp_alphapose_load(const char *path, gs_kp_people *people, gs_kpread_erro
     if (!text)
         return false;
     gs_jlex lex;
-    gs_jlex_init(&lex, text, len);
     gs_jtok t;
     bool ok = false;
-    gs_jt k = gs_jlex_next(&lex, &t);
-    if (k == GS_JT_ERROR) {
-        if (len == 0)
-            gs_kpread_fail(err, GS_KPR_EDATA, path, 1, NULL, "empty file");
-        else
-            gs_kp_json_syntax(&lex, path, err);
+    if (!gs_kp_json_begin(&lex, text, len, path, GS_JT_ARR,
+                          "expected a JSON array of results (AlphaPose result list)", &t, err))
         goto out;
-    }
-    if (k != GS_JT_ARR) {
-        gs_kpread_fail(err, GS_KPR_EDATA, path, t.line, NULL,
-                       "expected a JSON array of results (AlphaPose result list)");
-        goto out;
-    }
+    gs_jt k;
     for (;;) {
         k = gs_jlex_next(&lex, &t);
         if (k == GS_JT_ARR_END)

@@ -104,21 +104,11 @@ static bool parse_file(const char *path, uint64_t frame, gs_kp_people *people,
         return false;
     bool ok = false;
     gs_jlex lex;
-    gs_jlex_init(&lex, text, len);
     gs_jtok t, v;
-    gs_jt k = gs_jlex_next(&lex, &t);
-    if (k == GS_JT_ERROR) {
-        if (len == 0)
-            gs_kpread_fail(err, GS_KPR_EDATA, path, 1, NULL, "empty file");
-        else
-            gs_kp_json_syntax(&lex, path, err);
+    if (!gs_kp_json_begin(&lex, text, len, path, GS_JT_OBJ, "expected a JSON object with \"people\"",
+                          &t, err))
         goto out;
-    }
-    if (k != GS_JT_OBJ) {
-        gs_kpread_fail(err, GS_KPR_EDATA, path, t.line, NULL,
-                       "expected a JSON object with \"people\"");
-        goto out;
-    }
+    gs_jt k;
     bool have_people = false;
     for (;;) {
         k = gs_jlex_next(&lex, &t);

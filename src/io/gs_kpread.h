@@ -107,6 +107,10 @@ bool gs_kp_json_numbers(gs_jlex *lex, const gs_jtok *v, const char *path, uint32
                         const char *key, double *out, size_t cap, size_t *n, gs_kpread_error *err);
 /* Report the lexer's syntax error as "path:line: invalid JSON: why". */
 void gs_kp_json_syntax(const gs_jlex *lex, const char *path, gs_kpread_error *err);
+/* Start reading a JSON file: the first token must be of kind want, else an error
+ * (empty file, syntax, or `what`) naming the file and line. */
+bool gs_kp_json_begin(gs_jlex *lex, const char *text, size_t len, const char *path, gs_jt want,
+                      const char *what, gs_jtok *first, gs_kpread_error *err);
 /* The tracker id of an "idx"/"person_id" value starting with token *v: a number
  * or an array whose first element is a number; -1 for null, [] or a negative id. */
 bool gs_kp_json_track(gs_jlex *lex, const gs_jtok *v, const char *path, uint32_t obj_line,
