@@ -17,6 +17,7 @@ namespace gs {
 namespace {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kAlphaFloor = 0.12;  // alpha below this is background noise, shadow or halo
 
 // ---------------------------------------------------------------- config ---
 
@@ -399,8 +400,10 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     for (int y = 0; y < roi.height; y++) {
         const float *ar = alpha.ptr<float>(y);
         for (int x = 0; x < roi.width; x++) {
-            double a = ar[x];
-            if (a == 0.0) continue;
+            /* the ball covers a pixel between none and all of it: shading above 1 and
+             * shadows or noise below a small floor would widen the measured disc */
+            double a = std::min(1.0, (double)ar[x]);
+            if (!(a >= kAlphaFloor)) continue;
             m0 += a;
             mx += a * x;
             my += a * y;
