@@ -589,7 +589,7 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         }
     }
 
-    vec2 hc;
+    vec2 hc = {0.0f, 0.0f};
     bool head_rebuilt;
     if (head_centre(&f, &hc, &head_rebuilt)) {
         add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, head_rebuilt);

@@ -190,8 +190,19 @@ struct Track {
     cv::Vec3f color;               // ball colour from sharp frames
     std::vector<Hist> hist;        // recent centres (auto colour learning)
     std::vector<Blob> blobs;       // recent blobs (auto colour learning)
+    std::vector<Hist> seg;         // raw centres since the last bounce (rolling shutter)
     bool matched = false;
+    bool dead = false;             // dropped when the colour was learned from another track
 };
+
+// Rolling shutter: a row y is exposed k (y - H/2) later than the middle row, so a
+// ball moving at v appears displaced by v k (y - H/2). k is unknown (readout time,
+// either direction); it is chosen per clip as the value that makes the flights
+// between bounces most parabolic (grid over k in frame-times per frame height).
+constexpr int kRsSteps = 41;         // k_rel = -1 .. +1 in steps of 0.05
+constexpr double kRsMax = 1.0;
+
+double rs_k_rel(int i) { return -kRsMax + 2.0 * kRsMax * i / (kRsSteps - 1); }
 
 // quadratic least squares y = c0 + c1 t + c2 t^2 ; returns rms residual
 bool fit_quad(const std::vector<double> &t, const std::vector<double> &y, double c[3], double *rms)
@@ -236,6 +247,14 @@ struct BallDetector::Impl {
     long frame = 0;
     double dt = 1.0 / 30.0;        // typical frame interval
     double last_t = kNaN;
+    double rs_sse[kRsSteps] = {};  // accumulated quadratic-fit SSE per k over finished flights
+    int rs_segments = 0;
+    double rs_k = 0.0;             // seconds per row in use (0 = no correction)
+    double rs_ay[kRsSteps] = {};   // last fitted vertical acceleration per k (px/s^2)
+    double rs_ay_best = 0.0;
+
+    void rs_segment(const std::vector<Hist> &seg, int rows);
+    void rs_correct(const Track &tr, double rows, double *x, double *y) const;
 
     explicit Impl(const BallConfig &c) : cfg(c)
     {
@@ -495,6 +514,69 @@ void BallDetector::Impl::learn_color(Track &tr)
     color_known = true;
 }
 
+void BallDetector::Impl::rs_segment(const std::vector<Hist> &seg0, int rows)
+{
+    // drop one sample at each end (contact) and require a long, tall flight
+    if (seg0.size() < 14) return;
+    std::vector<Hist> seg(seg0.begin() + 2, seg0.end() - 2);
+    double ymin = 1e30, ymax = -1e30;
+    for (const auto &h : seg) { ymin = std::min(ymin, h.y); ymax = std::max(ymax, h.y); }
+    if (ymax - ymin < 0.2 * rows) return;
+    size_t n = seg.size();
+    std::vector<double> t(n), yc(n), v(n);
+    for (size_t i = 0; i < n; i++) {
+        size_t a = i > 0 ? i - 1 : i, b = i + 1 < n ? i + 1 : i;
+        v[i] = (seg[b].y - seg[a].y) / (seg[b].t - seg[a].t);
+        t[i] = seg[i].t;
+    }
+    double sse[kRsSteps];
+    for (int k = 0; k < kRsSteps; k++) {
+        double ks = rs_k_rel(k) * dt / rows;
+        for (size_t i = 0; i < n; i++) yc[i] = seg[i].y - v[i] * ks * (seg[i].y - 0.5 * rows);
+        double c[3], rms;
+        if (!fit_quad(t, yc, c, &rms)) return;
+        sse[k] = rms * rms;
+        rs_ay[k] = 2.0 * c[2];
+    }
+    for (int k = 0; k < kRsSteps; k++) rs_sse[k] += sse[k];
+    rs_segments++;
+    int best = 0;
+    for (int k = 1; k < kRsSteps; k++)
+        if (rs_sse[k] < rs_sse[best]) best = k;
+    rs_ay_best = rs_ay[best];
+    int zero = (kRsSteps - 1) / 2;
+    // only a clear improvement counts (a global shutter stays uncorrected)
+    rs_k = rs_sse[best] < 0.5 * rs_sse[zero] ? rs_k_rel(best) * dt / rows : 0.0;
+    if (std::getenv("GS_BALL_DEBUG"))
+        std::fprintf(stderr, "rolling shutter: %d flights, k_rel %.2f, rms %.2f -> %.2f px\n", rs_segments,
+                     rs_k_rel(best), std::sqrt(rs_sse[zero] / rs_segments),
+                     std::sqrt(rs_sse[best] / rs_segments));
+}
+
+void BallDetector::Impl::rs_correct(const Track &tr, double rows, double *x, double *y) const
+{
+    if (rs_k == 0.0 || tr.seg.size() < 2) return;
+    size_t n = tr.seg.size();
+    const Hist &c = tr.seg[n - 1], &b = tr.seg[n - 2];
+    double vx, vy;
+    if (n >= 3) {  // second-order backward difference: exact on a parabola
+        const Hist &a = tr.seg[n - 3];
+        double h1 = c.t - b.t, h2 = b.t - a.t;
+        if (!(h1 > 0 && h2 > 0)) return;
+        double w0 = (2 * h1 + h2) / (h1 * (h1 + h2)), w1 = -(h1 + h2) / (h1 * h2), w2 = h1 / (h2 * (h1 + h2));
+        vx = w0 * c.x + w1 * b.x + w2 * a.x;
+        vy = w0 * c.y + w1 * b.y + w2 * a.y;
+    } else {  // just after a bounce: the chord plus the known fall of half a frame
+        double h = c.t - b.t;
+        if (!(h > 0)) return;
+        vx = (c.x - b.x) / h;
+        vy = (c.y - b.y) / h + 0.5 * rs_ay_best * h;
+    }
+    double dtr = rs_k * (*y - 0.5 * rows);
+    *x -= vx * dtr;
+    *y -= vy * dtr;
+}
+
 void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<BallObs> &out)
 {
     out.clear();
@@ -559,6 +641,17 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
                          cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
         find_blobs(cand, blobs, false);
     } else {
+        // colour learning needs a coloured ball: pixels more saturated than the
+        // background there (shadows and ghosts keep the background's saturation)
+        cv::Mat bg8, bghsv, satd;
+        bg_small.convertTo(bg8, CV_8UC3);
+        cv::cvtColor(bg8, bghsv, cv::COLOR_BGR2HSV);
+        std::vector<cv::Mat> hc, bc;
+        cv::split(hsv, hc);
+        cv::split(bghsv, bc);
+        cv::subtract(hc[1], bc[1], satd);
+        cv::Mat sat_ok = (satd > 38) & (hc[1] > 64) & (hc[2] > 25);
+        motion &= sat_ok;
         cv::morphologyEx(motion, cand, cv::MORPH_OPEN,
                          cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
         cv::morphologyEx(cand, cand, cv::MORPH_CLOSE,
@@ -646,6 +739,7 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         tr.t = t_s;
         tr.hits++;
         tr.misses = 0;
+        double d_prev = tr.hits >= 3 ? tr.d : kNaN;
         double dmeas = ms.ok && ms.ratio < cfg.max_blur_ratio ? ms.d_perp : b.d_eq_s / scale;
         tr.d = fresh ? dmeas : tr.d + 0.3 * (dmeas - tr.d);
         if (ms.ok && ms.ratio < 1.25 && !ms.at_edge) {
@@ -654,18 +748,36 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
             tr.have_color = true;
         }
         tr.hist.push_back({t_s, x, y, dmeas});
+        {
+            // a bounce (falling, then rising) closes the flight segment
+            size_t n = tr.seg.size();
+            if (n >= 2 && tr.seg[n - 1].y - tr.seg[n - 2].y > 0.0 && y - tr.seg[n - 1].y < 0.0) {
+                rs_segment(tr.seg, bgr.rows);
+                tr.seg.erase(tr.seg.begin(), tr.seg.end() - 1);
+            }
+            if (!tr.seg.empty() && t_s - tr.seg.back().t > 0.2) tr.seg.clear();
+            tr.seg.push_back({t_s, x, y, dmeas});
+            if (tr.seg.size() > 400) tr.seg.erase(tr.seg.begin());
+        }
         if (tr.hist.size() > 12) tr.hist.erase(tr.hist.begin());
         if (!color_known) {
             tr.blobs.push_back(b);
             if (tr.blobs.size() > 12) tr.blobs.erase(tr.blobs.begin());
-            if (ballistic(tr)) learn_color(tr);
+            if (ballistic(tr)) {
+                // the colour is known: the candidates of other colours go, the ball is track 0
+                learn_color(tr);
+                for (auto &o : tracks)
+                    if (&o != &tr) o.dead = true;
+                tr.id = 0;
+            }
             continue;  // nothing is reported before the colour is known
         }
-        if (tr.hits < 2 || !ms.ok) continue;
+        if (tr.hits < 2 || !ms.ok || tr.dead) continue;
         BallObs o;
         o.track = tr.id;
         o.x_px = ms.x;
         o.y_px = ms.y;
+        rs_correct(tr, bgr.rows, &o.x_px, &o.y_px);
         double conf = 1.0;
         bool good = true;
         if (ms.at_edge) { conf *= 0.3; good = false; }
@@ -675,6 +787,11 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         double cons = ms.d_area / ms.d_perp;
         if (cons < 0.85 || cons > 1.2) { good = false; conf *= 0.5; }
         if (ms.contrast < 30.0) { conf *= 0.5; }
+        // a sudden change of size: partly hidden or merged with something (its centre is off too)
+        if (std::isfinite(d_prev) && std::fabs(ms.d_perp / d_prev - 1.0) > 0.08 && ms.ratio < cfg.max_blur_ratio) {
+            good = false;
+            conf *= 0.2;
+        }
         if (ms.d_perp < cfg.min_diameter_px || ms.d_perp > cfg.max_diameter_px) { good = false; conf *= 0.5; }
         o.diameter_px = good ? ms.d_perp : kNaN;
         o.confidence = std::min(1.0, std::max(0.05, conf));
@@ -685,7 +802,7 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     for (auto &tr : tracks)
         if (!tr.matched) tr.misses++;
     tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
-                                [&](const Track &tr) { return tr.misses > max_miss; }),
+                                [&](const Track &tr) { return tr.dead || tr.misses > max_miss; }),
                  tracks.end());
     if (out.size() > (size_t)cfg.max_balls) out.resize((size_t)cfg.max_balls);
 

@@ -1,0 +1,575 @@
+// test_ball.cpp - the ball detector against truth: clips rendered here (a 6.7 cm
+// ball dropped under gravity with quadratic drag and bounces of restitution
+// 0.72, motion blur from sub-frame positions, shading, sensor noise, JPEG
+// compression as in MJPG, green distractors, two balls), checked per frame
+// (centre, diameter) and through the core (size per flight); the real clips in
+// GS_SHARED_DIR/data/real with their stated truth; the [ball] keys.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <string>
+#include <sys/stat.h>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+extern "C" {
+#include "gravscale/gravscale.h"
+#include "unity.h"
+}
+
+#include "ball_detector.hpp"
+
+#ifndef GS_SHARED_DIR
+#error "GS_SHARED_DIR must be defined"
+#endif
+
+void setUp(void) {}
+void tearDown(void) {}
+
+namespace {
+
+constexpr double kG = 9.81;
+
+// ---- the core behind the detector: one point pipeline per track ----------------
+
+struct Flight {
+    int track;
+    bool accepted;
+    double size_m, q, size_px;
+};
+
+struct Run {
+    std::vector<Flight> flights;
+    std::map<int, double> summary;  // track -> height_m (NaN none)
+    size_t n_obs = 0;
+};
+
+void on_event(void *ctx, const gs_event *ev)
+{
+    Run *r = static_cast<Run *>(ctx);
+    if (ev->type == GS_EV_JUMP) {
+        const gs_ev_jump &j = ev->u.jump;
+        r->flights.push_back({(int)j.track, j.accepted, j.height_m, j.q_m_per_px, j.size_px});
+        if (std::getenv("GS_TEST_VERBOSE"))
+            std::printf("  flight track %u %.3f-%.3f s: size %.4f m, %s %s, rms %.2f px, n %u\n", j.track,
+                        j.t_takeoff_s, j.t_land_s, j.height_m, j.accepted ? "accepted" : "rejected",
+                        gs_reject_reason_name(j.reason), j.rms_px, j.n_samples);
+    } else if (ev->type == GS_EV_SUMMARY) {
+        r->summary[(int)ev->u.height.track] = ev->u.height.height_m;
+    }
+}
+
+struct Pipes {
+    gs_core_config cfg;
+    std::map<int, std::pair<gs_pipeline *, std::vector<double> *>> p;
+    Run *run;
+    explicit Pipes(Run *r) : run(r)
+    {
+        gs_core_config_default(&cfg);
+        cfg.size_min_m = 0.02f;
+        cfg.size_max_m = 0.5f;
+    }
+    ~Pipes()
+    {
+        for (auto &kv : p) {
+            delete kv.second.first;
+            delete kv.second.second;
+        }
+    }
+    void push(double t, const gs::BallObs &o)
+    {
+        auto it = p.find(o.track);
+        if (it == p.end()) {
+            auto *st = new std::vector<double>(gs_pipeline_storage_bytes(&cfg) / sizeof(double) + 1);
+            auto *pl = new gs_pipeline;
+            TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(pl, &cfg, GS_LAYOUT_POINT, st->data(),
+                                                      st->size() * sizeof(double), on_event, run));
+            gs_pipeline_set_track(pl, (uint32_t)o.track);
+            it = p.emplace(o.track, std::make_pair(pl, st)).first;
+        }
+        gs_pipeline_push_point(it->second.first, t, (float)o.x_px, (float)o.y_px, (float)o.confidence,
+                               (float)o.diameter_px);
+        run->n_obs++;
+    }
+    void flush()
+    {
+        for (auto &kv : p) gs_pipeline_flush(kv.second.first);
+    }
+};
+
+double median(std::vector<double> v)
+{
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// the run's answer for one track: median of its accepted flights' sizes
+double track_size(const Run &r, int track, int *n_acc)
+{
+    std::vector<double> s;
+    for (const auto &f : r.flights)
+        if (f.track == track && f.accepted && std::isfinite(f.size_m)) s.push_back(f.size_m);
+    *n_acc = (int)s.size();
+    return median(s);
+}
+
+// the run's answer: the accepted flights of all tracks
+double run_size(const Run &r, int *n_acc, int *n_all)
+{
+    std::vector<double> s;
+    *n_all = (int)r.flights.size();
+    for (const auto &f : r.flights)
+        if (f.accepted && std::isfinite(f.size_m)) s.push_back(f.size_m);
+    *n_acc = (int)s.size();
+    return median(s);
+}
+
+// ---- rendering -------------------------------------------------------------------
+
+struct BallSim {
+    double x_m, z_m, vx, vz;   // z up, metres
+    double diam_m = 0.067;
+    double t_start;            // released (held still before)
+    double ts = 0.0;           // simulated up to this time
+    cv::Vec3f color;           // BGR
+};
+
+// quadratic drag of a tennis ball (rho 1.2, Cd 0.55, 57 g), bounces at z = r
+void sim_step(BallSim &b, double h)
+{
+    const double k = 0.5 * 1.2 * 0.55 * CV_PI * 0.25 * b.diam_m * b.diam_m / 0.057;
+    double v = std::hypot(b.vx, b.vz);
+    b.vx += -k * v * b.vx * h;
+    b.vz += (-kG - k * v * b.vz) * h;
+    b.x_m += b.vx * h;
+    b.z_m += b.vz * h;
+    double r = 0.5 * b.diam_m;
+    if (b.z_m < r && b.vz < 0) {
+        b.z_m = 2 * r - b.z_m;
+        b.vz = -0.72 * b.vz;
+    }
+}
+
+struct Scene {
+    int w, h;
+    double fps, exposure_s, q;    // q: metres per pixel at the balls' depth
+    double x0_px, floor_px;       // image of x = 0 and of z = 0
+    double noise;
+    int jpeg_quality;
+    std::vector<BallSim> balls;
+    bool distractors = false;
+};
+
+struct Truth {
+    double x, y;  // exposure-mean centre, px
+    bool in_flight;
+};
+
+cv::Mat background(const Scene &s)
+{
+    cv::Mat bg(s.h, s.w, CV_32FC3);
+    for (int y = 0; y < s.h; y++)
+        for (int x = 0; x < s.w; x++) {
+            float g = 150.0f + 40.0f * (float)y / (float)s.h + 8.0f * (float)std::sin(x * 0.05) * (float)std::sin(y * 0.031);
+            bg.at<cv::Vec3f>(y, x) = cv::Vec3f(g + 6.0f, g + 2.0f, g - 4.0f);
+        }
+    // floor
+    int fy = (int)s.floor_px;
+    if (fy < s.h) bg.rowRange(fy, s.h).setTo(cv::Scalar(60, 95, 130));
+    if (s.distractors) {
+        // green objects of the wrong hue: a static disc, a plant-like blob, a ball on the floor
+        cv::circle(bg, cv::Point(s.w / 6, s.h / 3), 30, cv::Scalar(40, 170, 40), cv::FILLED, cv::LINE_AA);
+        cv::ellipse(bg, cv::Point(5 * s.w / 6, s.h / 2), cv::Size(60, 25), 20, 0, 360, cv::Scalar(60, 150, 30),
+                    cv::FILLED, cv::LINE_AA);
+        cv::circle(bg, cv::Point(s.w / 2 + 200, fy - 20), 20, cv::Scalar(50, 200, 70), cv::FILLED, cv::LINE_AA);
+    }
+    return bg;
+}
+
+// Paint ball b with the sub-frame centres (px) on img (coverage by 4x4 supersampling, averaged
+// over the sub-frames), with a shading from the top left.
+void paint(cv::Mat &img, const std::vector<cv::Point2d> &cs, double r, const cv::Vec3f &col)
+{
+    double minx = 1e9, maxx = -1e9, miny = 1e9, maxy = -1e9;
+    for (const auto &c : cs) {
+        minx = std::min(minx, c.x); maxx = std::max(maxx, c.x);
+        miny = std::min(miny, c.y); maxy = std::max(maxy, c.y);
+    }
+    int x0 = std::max(0, (int)std::floor(minx - r - 2)), x1 = std::min(img.cols - 1, (int)std::ceil(maxx + r + 2));
+    int y0 = std::max(0, (int)std::floor(miny - r - 2)), y1 = std::min(img.rows - 1, (int)std::ceil(maxy + r + 2));
+    const int S = 4;
+    double inv = 1.0 / (S * S * (double)cs.size());
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            double cov = 0;
+            cv::Vec3f acc(0, 0, 0);
+            for (const auto &c : cs)
+                for (int sy = 0; sy < S; sy++)
+                    for (int sx = 0; sx < S; sx++) {
+                        double px = x + (sx + 0.5) / S - 0.5 - c.x, py = y + (sy + 0.5) / S - 0.5 - c.y;
+                        double d2 = px * px + py * py;
+                        if (d2 > r * r) continue;
+                        double shade = 1.0 - 0.18 * (px + py) / (2.0 * r) - 0.12 * d2 / (r * r);
+                        acc += col * (float)shade;
+                        cov += 1.0;
+                    }
+            if (cov == 0) continue;
+            cv::Vec3f &p = img.at<cv::Vec3f>(y, x);
+            float a = (float)(cov * inv);
+            p = p * (1.0f - a) + acc * (float)inv;
+        }
+}
+
+// Render and detect frame by frame; returns the truth per ball and frame.
+void render_run(Scene s, double duration, const gs::BallConfig &bc, Run &run,
+                std::vector<std::vector<std::pair<Truth, gs::BallObs>>> *per_frame)
+{
+    cv::Mat bg = background(s);
+    gs::BallDetector det(bc);
+    Pipes pipes(&run);
+    cv::RNG rng(12345);
+    const int sub = 8;
+    const double hsim = 1e-4;
+    int nframes = (int)(duration * s.fps);
+    std::vector<gs::BallObs> obs;
+    for (int f = 0; f < nframes; f++) {
+        double t = f / s.fps;
+        cv::Mat img = bg.clone();
+        std::vector<Truth> truth;
+        for (auto &b : s.balls) {
+            std::vector<cv::Point2d> cs;
+            double t_open = t - 0.5 * s.exposure_s;
+            auto advance = [&](BallSim &x, double to) {
+                while (x.ts + hsim <= to) {
+                    if (x.ts >= x.t_start) sim_step(x, hsim);
+                    x.ts += hsim;
+                }
+            };
+            advance(b, t_open);
+            BallSim bb = b;
+            cv::Point2d mean(0, 0);
+            for (int k = 0; k < sub; k++) {
+                advance(bb, t_open + s.exposure_s * (k + 0.5) / sub);
+                cv::Point2d c(s.x0_px + bb.x_m / s.q, s.floor_px - bb.z_m / s.q);
+                cs.push_back(c);
+                mean += c * (1.0 / sub);
+            }
+            paint(img, cs, 0.5 * b.diam_m / s.q, b.color);
+            bool flying = t > b.t_start + 0.02 && bb.z_m > 0.5 * b.diam_m + 0.002;
+            truth.push_back({mean.x, mean.y, flying});
+        }
+        cv::Mat noise(img.size(), CV_32FC3);
+        rng.fill(noise, cv::RNG::NORMAL, 0.0, s.noise);
+        img += noise;
+        cv::Mat u8;
+        img.convertTo(u8, CV_8UC3);
+        std::vector<uchar> jpg;
+        cv::imencode(".jpg", u8, jpg, {cv::IMWRITE_JPEG_QUALITY, s.jpeg_quality});
+        cv::Mat dec = cv::imdecode(jpg, cv::IMREAD_COLOR);
+        det.process(dec, t, obs);
+        for (const auto &o : obs) {
+            pipes.push(t, o);
+            if (per_frame) {
+                // the truth nearest to this observation
+                size_t bi = 0;
+                double best = 1e30;
+                for (size_t i = 0; i < truth.size(); i++) {
+                    double d = std::hypot(truth[i].x - o.x_px, truth[i].y - o.y_px);
+                    if (d < best) { best = d; bi = i; }
+                }
+                per_frame->resize(std::max(per_frame->size(), bi + 1));
+                (*per_frame)[bi].push_back({truth[bi], o});
+            }
+        }
+    }
+    pipes.flush();
+}
+
+Scene scene_1080p60(double dist_m)
+{
+    // a 1080p camera with a 1500 px focal length: q = distance / focal
+    Scene s;
+    s.w = 1920; s.h = 1080; s.fps = 60; s.exposure_s = 1.0 / 120.0;
+    s.q = dist_m / 1500.0;
+    s.x0_px = 900; s.floor_px = 1000;
+    s.noise = 3.0; s.jpeg_quality = 85;
+    return s;
+}
+
+BallSim tennis(double x_m, double z_m, double t_start)
+{
+    BallSim b;
+    b.x_m = x_m; b.z_m = z_m; b.vx = 0.15; b.vz = 0.0;
+    b.t_start = t_start;
+    b.color = cv::Vec3f(50.0f, 225.0f, 205.0f);  // yellow-green felt (BGR)
+    return b;
+}
+
+}  // namespace
+
+// ---- rendered clips --------------------------------------------------------------
+
+// One ball, 1080p60, 2.5 m away (D = 40 px): sub-pixel centre and diameter per frame,
+// and the size of each flight through the core.
+void test_rendered_single_ball_centre_and_diameter(void)
+{
+    Scene s = scene_1080p60(2.5);
+    s.balls.push_back(tennis(0.0, 1.3, 0.3));
+    const double d_px = 0.067 / s.q;
+    Run run;
+    std::vector<std::vector<std::pair<Truth, gs::BallObs>>> pf;
+    render_run(s, 2.6, gs::BallConfig(), run, &pf);
+    TEST_ASSERT_EQUAL_MESSAGE(1, (int)pf.size(), "observations of one ball only");
+    std::vector<double> cerr, derr;
+    for (const auto &p : pf[0]) {
+        if (!p.first.in_flight) continue;
+        cerr.push_back(std::hypot(p.second.x_px - p.first.x, p.second.y_px - p.first.y));
+        if (std::isfinite(p.second.diameter_px)) derr.push_back(p.second.diameter_px - d_px);
+    }
+    TEST_ASSERT_TRUE_MESSAGE(cerr.size() > 60, "the ball is followed through its flights");
+    double c_med = median(cerr), d_med = median(derr);
+    std::vector<double> adr;
+    for (double e : derr) adr.push_back(std::fabs(e));
+    std::printf("single ball: %zu in-flight observations, %zu with a diameter; centre error median %.3f px, "
+                "diameter %.2f px truth, error median %+.3f px, |error| median %.3f px\n",
+                cerr.size(), derr.size(), c_med, d_px, d_med, median(adr));
+    TEST_ASSERT_TRUE_MESSAGE(c_med < 0.35, "sub-pixel centre");
+    TEST_ASSERT_TRUE_MESSAGE(std::fabs(d_med) < 0.02 * d_px, "diameter within 2 % (median)");
+    int n_acc = 0, n_all = 0;
+    double size = run_size(run, &n_acc, &n_all);
+    std::printf("single ball: %d flights accepted, size %.4f m (truth 0.0670)\n", n_acc, size);
+    TEST_ASSERT_TRUE_MESSAGE(n_acc >= 2, "the bounces are measured");
+    TEST_ASSERT_FLOAT_WITHIN(0.05 * 0.067, 0.067, size);
+}
+
+// Two balls at once and green distractors (static and of the wrong hue), 1080p60 at 3.5 m:
+// each ball its own track with its own flights, no observation on a distractor.
+void test_rendered_two_balls_with_distractors(void)
+{
+    Scene s = scene_1080p60(3.5);
+    s.distractors = true;
+    s.balls.push_back(tennis(-0.6, 1.5, 0.3));
+    s.balls.push_back(tennis(0.7, 1.1, 0.5));
+    Run run;
+    std::vector<std::vector<std::pair<Truth, gs::BallObs>>> pf;
+    render_run(s, 2.6, gs::BallConfig(), run, &pf);
+    TEST_ASSERT_EQUAL_MESSAGE(2, (int)pf.size(), "both balls observed");
+    for (size_t b = 0; b < pf.size(); b++)
+        for (const auto &p : pf[b])
+            TEST_ASSERT_TRUE_MESSAGE(std::hypot(p.second.x_px - p.first.x, p.second.y_px - p.first.y) < 3.0,
+                                     "every observation is on a ball, none on a distractor");
+    std::map<int, int> tracks;
+    for (const auto &f : run.flights) tracks[f.track]++;
+    int with_size = 0;
+    for (const auto &kv : tracks) {
+        int n_acc = 0;
+        double size = track_size(run, kv.first, &n_acc);
+        std::printf("two balls: track %d, %d flights accepted, size %.4f m\n", kv.first, n_acc, size);
+        if (n_acc > 0) {
+            TEST_ASSERT_FLOAT_WITHIN(0.05 * 0.067, 0.067, size);
+            with_size++;
+        }
+    }
+    TEST_ASSERT_EQUAL_MESSAGE(2, with_size, "both balls measured, each on its own track");
+}
+
+// The colour can be given; a hue far from the ball's finds nothing.
+void test_rendered_fixed_colour(void)
+{
+    Scene s = scene_1080p60(2.0);
+    s.w = 1280; s.h = 720; s.x0_px = 600; s.floor_px = 680;
+    s.fps = 120; s.exposure_s = 1.0 / 240.0;
+    s.q = 2.0 / 1000.0;
+    s.balls.push_back(tennis(0.0, 1.0, 0.2));
+    gs::BallConfig bc;
+    char msg[96];
+    TEST_ASSERT_EQUAL(GS_OK, gs::ball_config_set(&bc, "hue_deg", 7, "68", 2, msg, sizeof msg));
+    Run run;
+    render_run(s, 1.6, bc, run, nullptr);
+    int n_acc = 0, n_all = 0;
+    double size = run_size(run, &n_acc, &n_all);
+    std::printf("fixed colour, 720p120: %d flights accepted, size %.4f m\n", n_acc, size);
+    TEST_ASSERT_TRUE(n_acc >= 1);
+    TEST_ASSERT_FLOAT_WITHIN(0.05 * 0.067, 0.067, size);
+
+    gs::BallConfig wrong;
+    TEST_ASSERT_EQUAL(GS_OK, gs::ball_config_set(&wrong, "hue_deg", 7, "220", 3, msg, sizeof msg));
+    Run none;
+    render_run(s, 0.8, wrong, none, nullptr);
+    TEST_ASSERT_EQUAL_MESSAGE(0, (int)none.n_obs, "a blue ball is not looked for a yellow one");
+}
+
+// ---- real clips ------------------------------------------------------------------
+
+namespace {
+
+bool real_clip(const char *rel, std::string *path)
+{
+    *path = std::string(GS_SHARED_DIR) + "/data/real/" + rel;
+    struct stat st;
+    return stat(path->c_str(), &st) == 0;
+}
+
+void run_clip(const std::string &path, Run &run, double *ms_per_frame)
+{
+    cv::VideoCapture cap(path);
+    TEST_ASSERT_TRUE_MESSAGE(cap.isOpened(), path.c_str());
+    double fps = cap.get(cv::CAP_PROP_FPS);
+    TEST_ASSERT_TRUE(fps > 0);
+    gs::BallDetector det{gs::BallConfig()};
+    Pipes pipes(&run);
+    std::vector<gs::BallObs> obs;
+    cv::Mat f;
+    int i = 0;
+    int64 ticks = 0;
+    while (cap.read(f)) {
+        double t = i++ / fps;
+        int64 t0 = cv::getTickCount();
+        det.process(f, t, obs);
+        ticks += cv::getTickCount() - t0;
+        for (const auto &o : obs) pipes.push(t, o);
+    }
+    pipes.flush();
+    *ms_per_frame = 1000.0 * (double)ticks / cv::getTickFrequency() / std::max(1, i);
+}
+
+}  // namespace
+
+// 6.87 cm green ball, 1080p30, bounces on a wood floor (author's scale 8.09e-4 m/px).
+void test_real_bouncing_ball_ameen(void)
+{
+    std::string p;
+    if (!real_clip("bouncing_ball_ameen/bounceAmeen.avi", &p))
+        TEST_IGNORE_MESSAGE("GS_SHARED_DIR/data/real/bouncing_ball_ameen is absent");
+    Run run;
+    double ms;
+    run_clip(p, run, &ms);
+    int n_acc, n_all;
+    double size = run_size(run, &n_acc, &n_all);
+    double q = NAN;
+    for (const auto &f : run.flights)
+        if (f.accepted) { q = f.q; break; }
+    std::printf("bounceAmeen: %d/%d flights accepted, diameter %.4f m (truth 0.0687, %+.1f %%), q %.3g m/px "
+                "(author 8.09e-4), %.1f ms/frame\n",
+                n_acc, n_all, size, 100.0 * (size / 0.0687 - 1.0), q, ms);
+    TEST_ASSERT_TRUE(n_acc >= 1);
+    TEST_ASSERT_FLOAT_WITHIN(0.05 * 0.0687, 0.0687, size);
+    TEST_ASSERT_FLOAT_WITHIN(0.05 * 8.09e-4, 8.09e-4, q);
+}
+
+// a tennis ball (6.54-6.86 cm) thrown against a wall, 720p30 phone clip (rolling shutter)
+void test_real_tennis_kth_720p(void)
+{
+    std::string p;
+    if (!real_clip("tennis_bounce_kth/single_ball_1-long_720p30.mp4", &p))
+        TEST_IGNORE_MESSAGE("GS_SHARED_DIR/data/real/tennis_bounce_kth is absent");
+    Run run;
+    double ms;
+    run_clip(p, run, &ms);
+    int n_acc, n_all;
+    double size = run_size(run, &n_acc, &n_all);
+    std::printf("tennis 720p: %d/%d flights accepted, diameter %.4f m (tennis ball 0.0654-0.0686), %.1f ms/frame\n",
+                n_acc, n_all, size, ms);
+    TEST_ASSERT_TRUE(n_acc >= 1);
+    TEST_ASSERT_TRUE(size > 0.0654 * 0.95 && size < 0.0686 * 1.05);
+}
+
+// people walking, no ball: nothing at all
+void test_real_vtest_reports_nothing(void)
+{
+    std::string p;
+    if (!real_clip("opencv_vtest/vtest_first15s_h264.mp4", &p))
+        TEST_IGNORE_MESSAGE("GS_SHARED_DIR/data/real/opencv_vtest is absent");
+    Run run;
+    double ms;
+    run_clip(p, run, &ms);
+    std::printf("vtest: %zu observations, %zu flights, %.1f ms/frame\n", run.n_obs, run.flights.size(), ms);
+    TEST_ASSERT_EQUAL_MESSAGE(0, (int)run.flights.size(), "no flight in a clip without a ball");
+}
+
+// ---- [ball] keys ---------------------------------------------------------------------
+
+namespace {
+
+gs_status parse_ball(const char *text, gs::BallConfig *c, gs_cfg_error *err)
+{
+    gs_cfg_section sec = {"ball", gs::ball_config_set, c};
+    return gs_cfg_parse(text, std::strlen(text), &sec, 1, err);
+}
+
+}  // namespace
+
+void test_config_keys(void)
+{
+    gs::BallConfig c;
+    gs_cfg_error err;
+    const char *ok = "[ball]\nhue_deg = 72\nhue_tol_deg = 12\nsat_min = 0.3\nval_min = 0.2\n"
+                     "min_diameter_px = 8\nmax_diameter_px = 300\nmax_balls = 2\nroi = 10, 20, 640, 360\n"
+                     "motion_min = 25\nmax_blur_ratio = 1.5\n";
+    TEST_ASSERT_EQUAL(GS_OK, parse_ball(ok, &c, &err));
+    TEST_ASSERT_FALSE(c.color_auto);
+    TEST_ASSERT_EQUAL_DOUBLE(72.0, c.hue_deg);
+    TEST_ASSERT_EQUAL_DOUBLE(12.0, c.hue_tol_deg);
+    TEST_ASSERT_EQUAL(2, c.max_balls);
+    TEST_ASSERT_TRUE(c.roi_set);
+    TEST_ASSERT_EQUAL(20, c.roi_y);
+    TEST_ASSERT_EQUAL(360, c.roi_h);
+    char msg[96];
+    TEST_ASSERT_EQUAL(GS_OK, gs::ball_config_check(c, msg, sizeof msg));
+
+    gs::BallConfig a;
+    TEST_ASSERT_EQUAL(GS_OK, parse_ball("[ball]\ncolor = auto\nroi = full\n", &a, &err));
+    TEST_ASSERT_TRUE(a.color_auto);
+    TEST_ASSERT_FALSE(a.roi_set);
+
+    struct Bad { const char *text; gs_status st; const char *key; };
+    const Bad bad[] = {
+        {"[ball]\nhue_deg = 400\n", GS_ERANGE, "hue_deg"},
+        {"[ball]\nhue_deg = green\n", GS_EINVAL, "hue_deg"},
+        {"[ball]\nsat_min = 1.5\n", GS_ERANGE, "sat_min"},
+        {"[ball]\nmax_balls = 2.5\n", GS_EINVAL, "max_balls"},
+        {"[ball]\nmax_balls = 0\n", GS_ERANGE, "max_balls"},
+        {"[ball]\nroi = 1,2,30\n", GS_EINVAL, "roi"},
+        {"[ball]\nroi = 1,2,3,4\n", GS_ERANGE, "roi"},
+        {"[ball]\ncolor = red\n", GS_EINVAL, "color"},
+        {"[ball]\nmin_diameter_px = nan\n", GS_EINVAL, "min_diameter_px"},
+        {"[ball]\ndiameter = 5\n", GS_ENOKEY, "diameter"},
+    };
+    for (const auto &b : bad) {
+        gs::BallConfig x;
+        gs_cfg_error e;
+        std::memset(&e, 0, sizeof e);
+        TEST_ASSERT_EQUAL_MESSAGE(b.st, parse_ball(b.text, &x, &e), b.text);
+        TEST_ASSERT_EQUAL_STRING_MESSAGE(b.key, e.key, b.text);
+        TEST_ASSERT_EQUAL_UINT32(2, e.line);
+        TEST_ASSERT_TRUE_MESSAGE(e.msg[0] != '\0', b.text);
+    }
+    gs::BallConfig fixed_no_hue;
+    TEST_ASSERT_EQUAL(GS_OK, parse_ball("[ball]\ncolor = fixed\n", &fixed_no_hue, &err));
+    TEST_ASSERT_NOT_EQUAL(GS_OK, gs::ball_config_check(fixed_no_hue, msg, sizeof msg));
+    gs::BallConfig range;
+    TEST_ASSERT_EQUAL(GS_OK, parse_ball("[ball]\nmin_diameter_px = 50\nmax_diameter_px = 40\n", &range, &err));
+    TEST_ASSERT_NOT_EQUAL(GS_OK, gs::ball_config_check(range, msg, sizeof msg));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_config_keys);
+    RUN_TEST(test_rendered_single_ball_centre_and_diameter);
+    RUN_TEST(test_rendered_two_balls_with_distractors);
+    RUN_TEST(test_rendered_fixed_colour);
+    RUN_TEST(test_real_bouncing_ball_ameen);
+    RUN_TEST(test_real_tennis_kth_720p);
+    RUN_TEST(test_real_vtest_reports_nothing);
+    return UNITY_END();
+}
