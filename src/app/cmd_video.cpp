@@ -249,6 +249,11 @@ void on_event(void *ctx, const gs_event *ev)
 {
     App &a = *static_cast<App *>(ctx);
     char buf[GS_EMIT_MAX];
+    // a track other than 0 that never had a flight (a distractor followed for a
+    // moment) gets no summary; track 0 always does, with a null size if need be
+    if (ev->type == GS_EV_SUMMARY && ev->u.height.track != 0 && ev->u.height.n_jumps == 0 &&
+        ev->u.height.n_rejected == 0)
+        return;
     record_event(a, ev);
     if (a.trace_on) {
         size_t n = gs_emit_json(ev, buf, sizeof buf);

@@ -242,7 +242,10 @@ struct BallDetector::Impl {
     double hue = 0, hue_tol = 16, sat_min = 0.25, val_min = 0.15;
     double scale = 1.0;            // small = full * scale
     cv::Mat bg_small, bg_full;     // CV_32FC3 running backgrounds
-    cv::Mat small, hsv, motion, cand, upd_mask_small, upd_mask_full;
+    cv::Mat small, hsv, motion, cand;
+    cv::Mat bg_sat;                // the background's HSV saturation (working resolution)
+    long bg_sat_frame = -100;
+    std::vector<cv::Rect> keep_s;  // regions (working resolution) the background must not learn this frame
     std::vector<Track> tracks;
     long frame = 0;
     double dt = 1.0 / 30.0;        // typical frame interval
@@ -600,9 +603,9 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     }
     cv::cvtColor(small, hsv, cv::COLOR_BGR2HSV);
     // motion: difference to the background, any channel
-    cv::Mat sf, diff;
-    small.convertTo(sf, CV_32FC3);
-    cv::absdiff(sf, bg_small, diff);
+    cv::Mat bg8, diff;  // in 8 bits: the threshold is whole grey levels anyway, and it is ~4x cheaper
+    bg_small.convertTo(bg8, CV_8UC3);
+    cv::absdiff(small, bg8, diff);
     std::vector<cv::Mat> ch;
     cv::split(diff, ch);
     cv::Mat mx = cv::max(cv::max(ch[0], ch[1]), ch[2]);
@@ -643,14 +646,17 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     } else {
         // colour learning needs a coloured ball: pixels more saturated than the
         // background there (shadows and ghosts keep the background's saturation)
-        cv::Mat bg8, bghsv, satd;
-        bg_small.convertTo(bg8, CV_8UC3);
-        cv::cvtColor(bg8, bghsv, cv::COLOR_BGR2HSV);
-        std::vector<cv::Mat> hc, bc;
-        cv::split(hsv, hc);
-        cv::split(bghsv, bc);
-        cv::subtract(hc[1], bc[1], satd);
-        cv::Mat sat_ok = (satd > 38) & (hc[1] > 64) & (hc[2] > 25);
+        if (frame - bg_sat_frame >= 8) {  // the background changes slowly: its saturation is refreshed every 8 frames
+            cv::Mat bghsv;
+            cv::cvtColor(bg8, bghsv, cv::COLOR_BGR2HSV);
+            cv::extractChannel(bghsv, bg_sat, 1);
+            bg_sat_frame = frame;
+        }
+        cv::Mat sat, val, satd;
+        cv::extractChannel(hsv, sat, 1);
+        cv::extractChannel(hsv, val, 2);
+        cv::subtract(sat, bg_sat, satd);
+        cv::Mat sat_ok = (satd > 38) & (sat > 64) & (val > 25);
         motion &= sat_ok;
         cv::morphologyEx(motion, cand, cv::MORPH_OPEN,
                          cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
@@ -712,13 +718,13 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     }
 
     // measure and update
-    upd_mask_small = cv::Mat(small.size(), CV_8U, cv::Scalar(255));
+    keep_s.clear();
     for (size_t bi = 0; bi < blobs.size(); bi++) {
         const Blob &b = blobs[bi];
         cv::Rect r = b.box_s;
         int m = (int)std::ceil(0.5 * b.d_eq_s) + 2;
         r = cv::Rect(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m) & roi_s;
-        upd_mask_small(r).setTo(0);
+        keep_s.push_back(r);
         int ti = blob_track[bi];
         if (ti < 0) continue;
         Track &tr = tracks[(size_t)ti];
@@ -806,12 +812,24 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
                  tracks.end());
     if (out.size() > (size_t)cfg.max_balls) out.resize((size_t)cfg.max_balls);
 
-    // backgrounds follow slow changes, not the balls
-    cv::accumulateWeighted(sf, bg_small, 0.04, upd_mask_small);
-    cv::resize(upd_mask_small, upd_mask_full, bgr.size(), 0, 0, cv::INTER_NEAREST);
-    cv::Mat bf;
-    bgr.convertTo(bf, CV_32FC3);
-    cv::accumulateWeighted(bf, bg_full, 0.04, upd_mask_full);
+    // backgrounds follow slow changes, not the balls: an unmasked update (SIMD,
+    // 8-bit source) with the balls' regions put back is ~5x cheaper than a masked one
+    cv::Rect roi_f(0, 0, bgr.cols, bgr.rows);
+    std::vector<cv::Rect> keep_f;
+    std::vector<cv::Mat> saved_s, saved_f;
+    for (const cv::Rect &r : keep_s) {
+        cv::Rect rf((int)std::floor(r.x / scale) - 1, (int)std::floor(r.y / scale) - 1,
+                    (int)std::ceil(r.width / scale) + 3, (int)std::ceil(r.height / scale) + 3);
+        keep_f.push_back(rf & roi_f);
+        saved_s.push_back(bg_small(r).clone());
+        saved_f.push_back(bg_full(keep_f.back()).clone());
+    }
+    cv::accumulateWeighted(small, bg_small, 0.04);
+    cv::accumulateWeighted(bgr, bg_full, 0.04);
+    for (size_t i = keep_s.size(); i-- > 0;) {
+        saved_s[i].copyTo(bg_small(keep_s[i]));
+        saved_f[i].copyTo(bg_full(keep_f[i]));
+    }
 }
 
 BallDetector::BallDetector(const BallConfig &cfg) : p_(new Impl(cfg)) {}
