@@ -1,0 +1,148 @@
+// camera_motion.cpp - background corners tracked by pyramidal Lucas-Kanade,
+// a RANSAC similarity per frame pair, chained to the first frame.
+#include "camera_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+namespace gs {
+
+namespace {
+
+cv::Matx23d compose(const cv::Matx23d &a, const cv::Matx23d &b)  // a after b
+{
+    cv::Matx33d A(a(0, 0), a(0, 1), a(0, 2), a(1, 0), a(1, 1), a(1, 2), 0, 0, 1);
+    cv::Matx33d B(b(0, 0), b(0, 1), b(0, 2), b(1, 0), b(1, 1), b(1, 2), 0, 0, 1);
+    cv::Matx33d C = A * B;
+    return cv::Matx23d(C(0, 0), C(0, 1), C(0, 2), C(1, 0), C(1, 1), C(1, 2));
+}
+
+cv::Point2d apply(const cv::Matx23d &m, cv::Point2d p)
+{
+    return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
+}
+
+bool inside_any(const std::vector<cv::Rect> &rs, cv::Point2f p)
+{
+    for (const cv::Rect &r : rs)
+        if (r.contains(cv::Point((int)p.x, (int)p.y))) return true;
+    return false;
+}
+
+}  // namespace
+
+CameraMotion::CameraMotion(const CameraMotionConfig &cfg) : cfg_(cfg), cur_from_ref_(1, 0, 0, 0, 1, 0) {}
+
+void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &exclude, CameraMotionFrame *out)
+{
+    *out = CameraMotionFrame();
+    if (bgr.empty()) return;
+    if (full_ != bgr.size()) {  // a new stream: start over
+        full_ = bgr.size();
+        have_ = false;
+        pts_.clear();
+        cur_from_ref_ = cv::Matx23d(1, 0, 0, 0, 1, 0);
+    }
+    frames_++;
+    scale_ = std::min(1.0, cfg_.work_width_px / bgr.cols);
+    cv::Mat grey, cur;
+    if (bgr.channels() == 3)
+        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    else
+        grey = bgr;
+    if (scale_ < 1.0)
+        cv::resize(grey, cur, cv::Size(), scale_, scale_, cv::INTER_AREA);
+    else
+        cur = grey.clone();
+
+    // subjects' regions at the working scale, grown by a margin (limbs swing out of boxes)
+    std::vector<cv::Rect> ex;
+    for (const cv::Rect &r : exclude) {
+        int m = (int)std::lround(0.15 * std::max(r.width, r.height) * scale_) + 4;
+        ex.push_back(cv::Rect((int)(r.x * scale_) - m, (int)(r.y * scale_) - m, (int)(r.width * scale_) + 2 * m,
+                              (int)(r.height * scale_) + 2 * m));
+    }
+
+    bool matched = false;
+    if (have_ && !pts_.empty()) {
+        std::vector<cv::Point2f> next;
+        std::vector<uchar> st;
+        std::vector<float> err;
+        cv::calcOpticalFlowPyrLK(prev_, cur, pts_, next, st, err, cv::Size(21, 21), 3);
+        std::vector<cv::Point2f> a, b;
+        for (size_t i = 0; i < pts_.size(); i++)
+            if (st[i] && !inside_any(ex, next[i]) && !inside_any(ex, pts_[i])) {
+                a.push_back(pts_[i]);
+                b.push_back(next[i]);
+            }
+        if ((int)a.size() >= cfg_.min_inliers) {
+            std::vector<uchar> inl;
+            cv::Mat m = cv::estimateAffinePartial2D(a, b, inl, cv::RANSAC, 1.0, 2000, 0.995, 10);
+            int n_in = 0;
+            for (uchar v : inl) n_in += v ? 1 : 0;
+            if (!m.empty() && n_in >= cfg_.min_inliers) {
+                // working -> full pixels: same linear part, translation / scale
+                cv::Matx23d step(m.at<double>(0, 0), m.at<double>(0, 1), m.at<double>(0, 2) / scale_,
+                                 m.at<double>(1, 0), m.at<double>(1, 1), m.at<double>(1, 2) / scale_);
+                cur_from_ref_ = compose(step, cur_from_ref_);
+                cv::Point2d c(0.5 * full_.width, 0.5 * full_.height);
+                out->step_px = cv::norm(apply(step, c) - c);
+                out->inliers = n_in;
+                matched = true;
+                std::vector<cv::Point2f> kept;
+                for (size_t i = 0; i < b.size(); i++)
+                    if (inl[i]) kept.push_back(b[i]);
+                pts_.swap(kept);
+            }
+        }
+        if (!matched) pts_.clear();
+    }
+    out->valid = matched || !have_;
+    cv::Point2d c(0.5 * full_.width, 0.5 * full_.height);
+    cv::Point2d cc = apply(cur_from_ref_, c);
+    out->dx_px = cc.x - c.x;
+    out->dy_px = cc.y - c.y;
+    out->rot_deg = std::atan2(cur_from_ref_(1, 0), cur_from_ref_(0, 0)) * 180.0 / M_PI;
+    out->scale = std::sqrt(std::fabs(cur_from_ref_(0, 0) * cur_from_ref_(1, 1) - cur_from_ref_(0, 1) * cur_from_ref_(1, 0)));
+    if (!have_) out->inliers = 0;
+
+    // refill the corners when they thin out (occlusion, leaving the view)
+    if ((int)pts_.size() < cfg_.max_features / 2) {
+        cv::Mat mask(cur.size(), CV_8U, cv::Scalar(255));
+        for (const cv::Rect &r : ex) mask(r & cv::Rect(0, 0, cur.cols, cur.rows)).setTo(0);
+        for (const cv::Point2f &p : pts_)
+            cv::circle(mask, p, (int)cfg_.min_spacing_px, cv::Scalar(0), -1);
+        // per cell of a 4x4 grid, so that no textured subject can hold most of the corners
+        const int grid = 4;
+        int per_cell = std::max(2, cfg_.max_features / (grid * grid));
+        std::vector<int> have(grid * grid, 0);
+        for (const cv::Point2f &p : pts_) {
+            int gx = std::min(grid - 1, (int)(p.x * grid / cur.cols)), gy = std::min(grid - 1, (int)(p.y * grid / cur.rows));
+            have[gy * grid + gx]++;
+        }
+        for (int gy = 0; gy < grid; gy++)
+            for (int gx = 0; gx < grid; gx++) {
+                int want = per_cell - have[gy * grid + gx];
+                if (want <= 0) continue;
+                cv::Rect cell(gx * cur.cols / grid, gy * cur.rows / grid, cur.cols / grid, cur.rows / grid);
+                std::vector<cv::Point2f> fresh;
+                cv::goodFeaturesToTrack(cur(cell), fresh, want, 0.01, cfg_.min_spacing_px, mask(cell), 5);
+                for (cv::Point2f &p : fresh) pts_.push_back(p + cv::Point2f((float)cell.x, (float)cell.y));
+            }
+    }
+    prev_ = cur;
+    have_ = true;
+}
+
+cv::Point2d CameraMotion::to_reference(cv::Point2d p) const
+{
+    cv::Matx23d inv;
+    cv::invertAffineTransform(cur_from_ref_, inv);
+    return apply(inv, p);
+}
+
+}  // namespace gs

@@ -1,0 +1,51 @@
+// camera_motion.hpp - is the camera still? Tracks background corners from frame
+// to frame (pyramidal Lucas-Kanade on a reduced grey image) and chains the
+// robust similarity transforms, so every frame gets the camera's displacement
+// since the first frame. The method assumes a static camera: a handheld one
+// adds its own acceleration to the body's, and this is how that gets noticed.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace gs {
+
+struct CameraMotionConfig {
+    int max_features = 150;        // background corners tracked
+    double work_width_px = 640.0;  // frames are reduced to at most this width
+    double min_spacing_px = 12.0;  // between corners, at the working width
+    int min_inliers = 12;          // fewer: the frame's motion is unknown
+};
+
+// The camera's motion at one frame, in full-frame pixels.
+struct CameraMotionFrame {
+    bool valid = false;            // false: too few background corners matched
+    double dx_px = 0.0;            // where the first frame's image centre is now, minus the centre
+    double dy_px = 0.0;
+    double rot_deg = 0.0;          // rotation since the first frame, clockwise on screen (y down)
+    double scale = 1.0;            // zoom since the first frame
+    double step_px = 0.0;          // displacement of the image centre since the previous frame
+    int inliers = 0;
+};
+
+class CameraMotion {
+public:
+    explicit CameraMotion(const CameraMotionConfig &cfg = CameraMotionConfig());
+    // exclude: regions of moving subjects (full-frame pixels) kept out of the corners
+    void process(const cv::Mat &bgr, const std::vector<cv::Rect> &exclude, CameraMotionFrame *out);
+    // map a point of this frame into the first frame's coordinates (stabilised)
+    cv::Point2d to_reference(cv::Point2d p) const;
+
+private:
+    CameraMotionConfig cfg_;
+    double scale_ = 1.0;           // working / full
+    cv::Mat prev_;                 // previous working grey frame
+    std::vector<cv::Point2f> pts_; // corners in prev_
+    cv::Matx23d cur_from_ref_;     // full-frame pixels: reference -> current
+    bool have_ = false;
+    long frames_ = 0;
+    cv::Size full_;
+};
+
+}  // namespace gs
