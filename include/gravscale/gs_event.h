@@ -30,6 +30,10 @@ typedef enum {
 #define GS_WARN_SIZE_CHANGED  0x04u /* "size_changed": standing size before and after differ */
 #define GS_WARN_OUTLIERS      0x08u /* "outliers": many samples rejected by the robust fit */
 #define GS_WARN_CLIPPED       0x10u /* "edge_truncated": flight window cut by a gap or the stream's end */
+/* set by the front end that owns the frames (the core cannot see them) */
+#define GS_WARN_CAMERA_MOVED  0x20u /* "camera_moved": the background moved during the flight (not a static camera) */
+#define GS_WARN_LEFT_FRAME    0x40u /* "left_frame": the body touched the frame's border during the flight */
+#define GS_WARN_OUT_OF_PLANE  0x80u /* "out_of_plane": the body moved toward or away from the camera */
 
 const char *gs_reject_reason_name(gs_reject_reason r);
 

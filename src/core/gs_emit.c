@@ -92,7 +92,7 @@ static size_t w_finish(gs_w *w)
 
 /* names of the GS_WARN_* bits, in bit order (protocol names) */
 static const char *const k_warn_names[] = {"few_samples", "gravity_tilt", "size_changed", "outliers",
-                                           "edge_truncated"};
+                                           "edge_truncated", "camera_moved", "left_frame", "out_of_plane"};
 
 static void json_jump(gs_w *w, const gs_ev_jump *j)
 {
