@@ -274,7 +274,7 @@ void test_ball_height_against_truth(void)
     TEST_ASSERT_NOT_NULL(strstr(r.out, cfgkey));
     TEST_ASSERT_TRUE(strstr(r.out, "\"fps_origin\":\"timestamps\"") < first_nl);
     TEST_ASSERT_TRUE(strstr(r.out, "\"layout\":\"point\"") < first_nl);
-    TEST_ASSERT_DOUBLE_WITHIN(0.01, FPS, field_of_last(r.out, "\"start\"", "fps_source"));
+    TEST_ASSERT_DOUBLE_WITHIN(0.01, FPS, field_of_last(r.out, "\"event\":\"start\"", "fps_source"));
     /* the summary last, once */
     TEST_ASSERT_EQUAL_INT(1, count_substr(r.out, "\"event\":\"summary\""));
     const char *last = r.out + r.out_len - 1;
@@ -516,7 +516,7 @@ void test_json_inputs_with_fps(void)
     assert_json_lines(r.out, r.out_len);
     TEST_ASSERT_NOT_NULL(strstr(r.out, "\"fps_origin\":\"cli\""));
     TEST_ASSERT_NOT_NULL(strstr(r.out, "\"layout\":\"coco17\""));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 25.0, field_of_last(r.out, "\"start\"", "fps_source"));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 25.0, field_of_last(r.out, "\"event\":\"start\"", "fps_source"));
     TEST_ASSERT_EQUAL_INT(1, count_substr(r.out, "\"event\":\"summary\""));
     run_free(&r);
 

@@ -56,6 +56,8 @@ typedef struct {
     float size_min_m, size_max_m;  /* plausible object size; a flight whose height falls outside is rejected */
     float max_gap_s;           /* a time gap longer than this ends any flight */
     float landing_latency_s;   /* decide a landing at most this long after it */
+    float session_absence_s;   /* no body for this long ends a visit (session) */
+    float session_new_body_rel;/* after a gap, a standing size this far off starts a new visit */
     gs_format format;          /* format = json|nmea (default output line format) */
 } gs_core_config;
 

@@ -9,6 +9,7 @@ typedef enum {
     GS_EV_JUMP,      /* one flight, accepted or rejected */
     GS_EV_HEIGHT,    /* running aggregate after each accepted flight */
     GS_EV_SUMMARY,   /* end of stream: the run's final answer */
+    GS_EV_SESSION,   /* a person's visit started or ended (body layouts) */
     GS_EV_STATE,     /* trace: state machine change */
     GS_EV_SAMPLE,    /* trace: one COM sample */
     GS_EV_FIT        /* trace: one fit attempt (window and result) */
@@ -67,6 +68,17 @@ typedef struct {
 } gs_ev_height;  /* also the summary */
 
 typedef struct {
+    uint32_t track;
+    uint32_t session;          /* 1-based visit number */
+    bool ended;                /* false: it started */
+    const char *reason;        /* end: "absence", "new_body", "end_of_stream"; NULL at the start */
+    double t_start_s, t_end_s; /* t_end_s NaN at the start */
+    double stature_m, ci95_lo_m, ci95_hi_m;   /* the visit's aggregate, NaN unknown */
+    uint32_t n_jumps, n_rejected;
+    double best_jump_m, mean_jump_m, best_flight_s, mean_flight_s, mean_takeoff_velocity_m_s;
+} gs_ev_session;
+
+typedef struct {
     double t_s;
     const char *from, *to;
 } gs_ev_state;
@@ -89,6 +101,7 @@ typedef struct {
         gs_ev_start start;
         gs_ev_jump jump;
         gs_ev_height height;   /* GS_EV_HEIGHT and GS_EV_SUMMARY */
+        gs_ev_session session;
         gs_ev_state state;
         gs_ev_sample sample;
         gs_ev_fit fit;

@@ -85,5 +85,9 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
 void gs_flight_update(gs_flight *f);
 /* End of stream: close any open candidate. */
 void gs_flight_finish(gs_flight *f);
+/* The standing size this sample added (NaN when the sample at t_s was no still, upright frame). */
+double gs_flight_stand_at(const gs_flight *f, double t_s);
+/* Someone else: forget the standing sizes (and the body axis) learnt so far. */
+void gs_flight_forget_body(gs_flight *f);
 
 #endif

@@ -9,13 +9,16 @@
 #include "gs_flight.h"
 #include "gs_agg.h"
 #include "gs_config.h"
+#include "gs_session.h"
 
 typedef struct {
     gs_core_config cfg;
     gs_layout layout;
     gs_ring ring;
     gs_flight flight;
-    gs_agg agg;
+    gs_agg agg;                /* per session for bodies (a new person starts afresh) */
+    gs_session session;        /* body layouts only; a ball has no visits */
+    bool sessions;
     gs_event_fn on_event;
     void *ctx;
     double last_t_s;

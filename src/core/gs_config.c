@@ -255,6 +255,8 @@ static const num_key k_num_keys[] = {
     {"size_max_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_max_m)},
     {"max_gap_s", T_FLT, 0.01, 2.0, offsetof(gs_core_config, max_gap_s)},
     {"landing_latency_s", T_FLT, 0.02, 1.0, offsetof(gs_core_config, landing_latency_s)},
+    {"session_absence_s", T_FLT, 0.5, 600.0, offsetof(gs_core_config, session_absence_s)},
+    {"session_new_body_rel", T_FLT, 0.03, 0.5, offsetof(gs_core_config, session_new_body_rel)},
 };
 
 void gs_core_config_default(gs_core_config *c)
@@ -278,6 +280,8 @@ void gs_core_config_default(gs_core_config *c)
     c->size_max_m = 2.6f;
     c->max_gap_s = 0.2f;
     c->landing_latency_s = 0.2f;
+    c->session_absence_s = 2.5f;
+    c->session_new_body_rel = 0.12f;
     c->format = GS_FMT_JSON;
 }
 

@@ -169,6 +169,47 @@ static void json_height(gs_w *w, const gs_ev_height *h, bool summary)
     w_lit(w, "}\n");
 }
 
+static void json_session(gs_w *w, const gs_ev_session *e)
+{
+    w_lit(w, "{\"event\":\"session\",\"track\":");
+    w_u32(w, e->track);
+    w_lit(w, ",\"session\":");
+    w_u32(w, e->session);
+    w_lit(w, e->ended ? ",\"state\":\"end\",\"reason\":" : ",\"state\":\"start\",\"reason\":");
+    w_jstr(w, e->reason);
+    w_lit(w, ",\"t_start_s\":");
+    w_fixed(w, e->t_start_s, 4);
+    w_lit(w, ",\"t_end_s\":");
+    w_fixed(w, e->t_end_s, 4);
+    w_lit(w, ",\"stature_m\":");
+    w_fixed(w, e->stature_m, 4);
+    w_lit(w, ",\"ci95_m\":");
+    if (isfinite(e->ci95_lo_m) && isfinite(e->ci95_hi_m) && isfinite(e->stature_m)) {
+        w_raw(w, "[", 1);
+        w_fixed(w, e->ci95_lo_m, 4);
+        w_raw(w, ",", 1);
+        w_fixed(w, e->ci95_hi_m, 4);
+        w_raw(w, "]", 1);
+    } else {
+        w_lit(w, "null");
+    }
+    w_lit(w, ",\"n_jumps\":");
+    w_u32(w, e->n_jumps);
+    w_lit(w, ",\"n_rejected\":");
+    w_u32(w, e->n_rejected);
+    w_lit(w, ",\"best_jump_m\":");
+    w_fixed(w, e->best_jump_m, 4);
+    w_lit(w, ",\"mean_jump_m\":");
+    w_fixed(w, e->mean_jump_m, 4);
+    w_lit(w, ",\"best_flight_s\":");
+    w_fixed(w, e->best_flight_s, 4);
+    w_lit(w, ",\"mean_flight_s\":");
+    w_fixed(w, e->mean_flight_s, 4);
+    w_lit(w, ",\"mean_takeoff_velocity_m_s\":");
+    w_fixed(w, e->mean_takeoff_velocity_m_s, 3);
+    w_lit(w, "}\n");
+}
+
 size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
 {
     gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
@@ -192,6 +233,7 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
     case GS_EV_JUMP: json_jump(&w, &ev->u.jump); break;
     case GS_EV_HEIGHT: json_height(&w, &ev->u.height, false); break;
     case GS_EV_SUMMARY: json_height(&w, &ev->u.height, true); break;
+    case GS_EV_SESSION: json_session(&w, &ev->u.session); break;
     case GS_EV_STATE: {
         const gs_ev_state *s = &ev->u.state;
         w_lit(&w, "{\"event\":\"state\",\"t_s\":");
@@ -313,6 +355,25 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
         n_num(&w, h->ci95_hi_m, 4, 12);
         n_u32(&w, h->n_jumps);
         if (ev->type == GS_EV_SUMMARY) n_u32(&w, h->n_rejected);
+        break;
+    }
+    case GS_EV_SESSION: {
+        /* widths: 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - "$GSSES" - 10 commas - "*HH\r\n" */
+        const gs_ev_session *e = &ev->u.session;
+        w_lit(&w, "$GSSES");
+        n_num(&w, (double)e->session, 0, 5);
+        w_lit(&w, e->ended ? ",E," : ",S,");
+        if (e->reason) {
+            char c = (char)(e->reason[0] >= 'a' && e->reason[0] <= 'z' ? e->reason[0] - 'a' + 'A' : '_');
+            w_raw(&w, &c, 1);  /* A absence, N new_body, E end_of_stream */
+        }
+        n_num(&w, e->t_start_s, 3, 10);
+        n_num(&w, e->t_end_s, 3, 10);
+        n_num(&w, e->stature_m, 3, 6);
+        n_num(&w, (double)e->n_jumps, 0, 3);
+        n_num(&w, e->best_jump_m, 3, 5);
+        n_num(&w, e->mean_jump_m, 3, 5);
+        n_num(&w, e->mean_flight_s, 3, 5);
         break;
     }
     case GS_EV_START:

@@ -822,6 +822,22 @@ static void update_standing(gs_flight *f, const gs_sample *s, double speed)
     }
 }
 
+double gs_flight_stand_at(const gs_flight *f, double t_s)
+{
+    if (!f || f->stand_n == 0 || !(f->stand_last_t == t_s)) return NAN;
+    return (double)f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
+}
+
+void gs_flight_forget_body(gs_flight *f)
+{
+    if (!f) return;
+    f->stand_n = f->stand_next = 0;
+    f->loose_n = f->loose_next = 0;
+    f->stand_last_t = NAN;
+    f->still_since = NAN;
+    if (!f->up_from_flight) f->up_n = 0;
+}
+
 static double size_ref(const gs_flight *f, const gs_sample *s)
 {
     if (f->stand_n > 0) {

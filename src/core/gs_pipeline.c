@@ -20,6 +20,7 @@ static void on_flight_event(void *ctx, const gs_event *ev)
     gs_pipeline *p = (gs_pipeline *)ctx;
     if (p->on_event) p->on_event(p->ctx, ev);
     if (ev->type != GS_EV_JUMP) return;
+    if (p->sessions) gs_session_jump(&p->session, &ev->u.jump);
     if (ev->u.jump.accepted) {
         gs_agg_add(&p->agg, ev->u.jump.height_m, ev->u.jump.height_se_m);
         gs_event h;
@@ -53,6 +54,8 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     gs_status st = gs_ring_init(&p->ring, samples, cap);
     if (st != GS_OK) return st;
     gs_agg_init(&p->agg);
+    p->sessions = layout != GS_LAYOUT_POINT;
+    gs_session_init(&p->session, (double)cfg->session_absence_s, (double)cfg->session_new_body_rel);
     return gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
                           on_flight_event, p);
 }
@@ -65,6 +68,33 @@ void gs_pipeline_set_track(gs_pipeline *p, uint32_t track)
 void gs_pipeline_set_trace(gs_pipeline *p, bool on)
 {
     if (p) p->flight.trace = on;
+}
+
+static void emit_session(gs_pipeline *p, bool ended, const char *reason)
+{
+    gs_event ev;
+    gs_event h;
+    memset(&h, 0, sizeof h);
+    gs_agg_get(&p->agg, &h.u.height);
+    gs_session_event(&p->session, ended, reason, &h.u.height, p->flight.track, &ev);
+    if (p->on_event) p->on_event(p->ctx, &ev);
+}
+
+/* A visit ends after a long absence or when someone else stands there; the
+ * next one starts with its own aggregate and standing size. */
+static void track_session(gs_pipeline *p, const gs_sample *s)
+{
+    bool present = s->w >= 0.05f && isfinite(s->x_px) && isfinite(s->y_px);
+    const char *why = NULL;
+    uint32_t r = gs_session_frame(&p->session, s->t_s, present, gs_flight_stand_at(&p->flight, s->t_s), &why);
+    if (r & GS_SESSION_ENDED) {
+        emit_session(p, true, why);
+        gs_session_close(&p->session);
+        gs_agg_init(&p->agg);
+        gs_flight_forget_body(&p->flight);
+        if (present) r = gs_session_frame(&p->session, s->t_s, present, NAN, &why);
+    }
+    if (r & GS_SESSION_STARTED) emit_session(p, false, NULL);
 }
 
 static gs_status push_sample(gs_pipeline *p, const gs_sample *s)
@@ -91,6 +121,7 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample *s)
         p->on_event(p->ctx, &ev);
     }
     gs_flight_update(&p->flight);
+    if (p->sessions) track_session(p, s);
     return GS_OK;
 }
 
@@ -136,6 +167,10 @@ gs_status gs_pipeline_flush(gs_pipeline *p)
     if (p->finished) return GS_ESTATE;
     gs_flight_finish(&p->flight);
     p->finished = true;
+    if (p->sessions && p->session.open) {
+        emit_session(p, true, "end_of_stream");
+        gs_session_close(&p->session);
+    }
     gs_event ev;
     memset(&ev, 0, sizeof ev);
     ev.type = GS_EV_SUMMARY;

@@ -1,0 +1,144 @@
+/* gs_session.c - sessions: presence, a reference standing size, per-visit results. */
+#include "gravscale/gs_session.h"
+
+#include <math.h>
+#include <string.h>
+
+#define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
+
+static void reset_visit(gs_session *s)
+{
+    s->gap_since_ref = false;
+    s->ref_n = 0;
+    s->ref_px = NAN;
+    s->odd_run = 0;
+    s->n_jumps = s->n_rejected = 0;
+    s->best_jump_m = s->best_flight_s = NAN;
+    s->sum_jump_m = s->sum_flight_s = s->sum_v_m_s = 0.0;
+    s->n_jump_h = s->n_v = s->n_flight_t = 0;
+}
+
+void gs_session_init(gs_session *s, double absence_s, double new_body_rel)
+{
+    if (!s) return;
+    memset(s, 0, sizeof *s);
+    s->absence_s = absence_s;
+    s->new_body_rel = new_body_rel;
+    s->gap_s = absence_s < 0.5 ? absence_s : 0.5;
+    s->t_start_s = s->t_seen_s = NAN;
+    reset_visit(s);
+}
+
+static double median_small(const float *v, uint32_t n)
+{
+    float t[GS_SESSION_REF_N];
+    for (uint32_t i = 0; i < n; i++) {
+        float x = v[i];
+        uint32_t j = i;
+        while (j > 0 && t[j - 1] > x) {
+            t[j] = t[j - 1];
+            j--;
+        }
+        t[j] = x;
+    }
+    return (n & 1u) ? (double)t[n / 2] : 0.5 * ((double)t[n / 2 - 1] + (double)t[n / 2]);
+}
+
+static uint32_t start(gs_session *s, double t_s)
+{
+    s->id++;
+    s->open = true;
+    s->t_start_s = s->t_seen_s = t_s;
+    reset_visit(s);
+    return GS_SESSION_STARTED;
+}
+
+uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_px, const char **end_reason)
+{
+    if (!s || !isfinite(t_s)) return 0;
+    if (end_reason) *end_reason = NULL;
+    if (!present) {
+        if (s->open && t_s - s->t_seen_s >= s->absence_s) {
+            if (end_reason) *end_reason = "absence";
+            return GS_SESSION_ENDED;  /* the caller emits the end, then gs_session_close */
+        }
+        return 0;
+    }
+    if (!s->open) return start(s, t_s);
+    if (t_s - s->t_seen_s >= s->gap_s && s->ref_n >= GS_SESSION_REF_N) s->gap_since_ref = true;
+    s->t_seen_s = t_s;
+    if (!isfinite(stand_px) || !(stand_px > 0.0)) return 0;
+    if (s->ref_n < GS_SESSION_REF_N) {
+        s->ref_acc[s->ref_n++] = (float)stand_px;
+        if (s->ref_n == GS_SESSION_REF_N) s->ref_px = median_small(s->ref_acc, s->ref_n);
+        return 0;
+    }
+    /* the same person stepping closer changes size while seen; someone else appears after a gap */
+    if (s->gap_since_ref && fabs(stand_px / s->ref_px - 1.0) > s->new_body_rel) {
+        if (++s->odd_run >= ODD_RUN_NEEDED) {
+            if (end_reason) *end_reason = "new_body";
+            return GS_SESSION_ENDED;
+        }
+    } else {
+        s->odd_run = 0;
+    }
+    return 0;
+}
+
+void gs_session_jump(gs_session *s, const gs_ev_jump *j)
+{
+    if (!s || !j || !s->open) return;
+    if (!j->accepted) {
+        s->n_rejected++;
+        return;
+    }
+    s->n_jumps++;
+    if (isfinite(j->jump_height_m)) {
+        s->sum_jump_m += j->jump_height_m;
+        s->n_jump_h++;
+        if (!(j->jump_height_m <= s->best_jump_m)) s->best_jump_m = j->jump_height_m;  /* NaN best: first */
+    }
+    if (isfinite(j->flight_time_s)) {
+        s->sum_flight_s += j->flight_time_s;
+        s->n_flight_t++;
+        if (!(j->flight_time_s <= s->best_flight_s)) s->best_flight_s = j->flight_time_s;
+    }
+    if (isfinite(j->takeoff_velocity_m_s)) {
+        s->sum_v_m_s += j->takeoff_velocity_m_s;
+        s->n_v++;
+    }
+}
+
+void gs_session_event(const gs_session *s, bool ended, const char *reason, const gs_ev_height *stature,
+                      uint32_t track, gs_event *ev)
+{
+    memset(ev, 0, sizeof *ev);
+    ev->type = GS_EV_SESSION;
+    gs_ev_session *e = &ev->u.session;
+    e->track = track;
+    e->session = s->id;
+    e->ended = ended;
+    e->reason = ended ? reason : NULL;
+    e->t_start_s = s->t_start_s;
+    e->t_end_s = ended ? s->t_seen_s : NAN;
+    e->stature_m = e->ci95_lo_m = e->ci95_hi_m = NAN;
+    e->best_jump_m = e->mean_jump_m = e->best_flight_s = e->mean_flight_s = e->mean_takeoff_velocity_m_s = NAN;
+    e->n_jumps = s->n_jumps;
+    e->n_rejected = s->n_rejected;
+    if (!ended) return;
+    if (stature) {
+        e->stature_m = stature->height_m;
+        e->ci95_lo_m = stature->ci95_lo_m;
+        e->ci95_hi_m = stature->ci95_hi_m;
+    }
+    e->best_jump_m = s->best_jump_m;
+    e->best_flight_s = s->best_flight_s;
+    if (s->n_jump_h) e->mean_jump_m = s->sum_jump_m / (double)s->n_jump_h;
+    if (s->n_flight_t) e->mean_flight_s = s->sum_flight_s / (double)s->n_flight_t;
+    if (s->n_v) e->mean_takeoff_velocity_m_s = s->sum_v_m_s / (double)s->n_v;
+}
+
+void gs_session_close(gs_session *s)
+{
+    if (s) s->open = false;
+}
