@@ -366,6 +366,7 @@ void test_full_house_refuses_extra_clients(void)
     peer_read(extra, 200);
     TEST_ASSERT_TRUE_MESSAGE(extra->eof, "the extra client was not closed");
     EQ_SZ(2, info_of(&s).c.clients);
+    EQ_SZ(1, info_of(&s).c.refused);
     write_lines(&s, 0, 3);
     while (peer_read(a, 30) > 0) {}
     while (peer_read(b, 30) > 0) {}

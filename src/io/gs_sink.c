@@ -259,11 +259,11 @@ size_t gs_sinkset_status_json(const gs_sinkset *set, char *buf, size_t cap)
              (in.last_errno ? put_json_str(buf, cap, &n, strerror(in.last_errno)) : put(buf, cap, &n, "null")) &&
              put(buf, cap, &n,
                  ",\"lines_in\":%llu,\"lines_sent\":%llu,\"lines_dropped\":%llu,\"bytes_sent\":%llu,"
-                 "\"lines_queued\":%llu,\"clients\":%u,\"reopens\":%llu}",
+                 "\"lines_queued\":%llu,\"clients\":%u,\"reopens\":%llu,\"refused\":%llu}",
                  (unsigned long long)in.c.lines_in, (unsigned long long)in.c.lines_sent,
                  (unsigned long long)in.c.lines_dropped, (unsigned long long)in.c.bytes_sent,
                  (unsigned long long)in.c.lines_queued, (unsigned)in.c.clients,
-                 (unsigned long long)in.c.reopens);
+                 (unsigned long long)in.c.reopens, (unsigned long long)in.c.refused);
     }
     ok = ok && put(buf, cap, &n, "]");
     if (!ok) {

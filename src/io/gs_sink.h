@@ -41,6 +41,7 @@ typedef struct {
     uint64_t lines_queued;  /* waiting now (TCP server: the largest client backlog) */
     uint32_t clients;       /* TCP server: connected clients */
     uint64_t reopens;       /* serial reopened / TCP client connections made / clients accepted */
+    uint64_t refused;       /* TCP server: clients turned away because max_clients were connected */
 } gs_sink_counters;
 
 typedef struct {

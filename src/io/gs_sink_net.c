@@ -227,6 +227,7 @@ static void tcp_info(const void *state, gs_sink_info *o)
     o->c.lines_dropped = s->gone_dropped + s->bad;
     o->c.bytes_sent = s->gone_bytes;
     o->c.reopens = s->accepted;
+    o->c.refused = s->refused;
     for (uint32_t i = 0; i < s->cfg.max_clients; i++) {
         const tcp_client *c = &s->cl[i];
         if (c->fd < 0)

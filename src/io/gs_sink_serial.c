@@ -17,7 +17,7 @@ typedef struct {
     int fd;
     gs_lineq q;
     gs_lineq_reader r;
-    uint64_t in, too_long, reopens;
+    uint64_t in, bad, reopens; /* bad: lines refused (no newline, too long) */
     int last_errno;
     double now_s, next_open_s;
 } serial_sink;
@@ -115,7 +115,7 @@ static int serial_write_line(void *state, const char *line, size_t len)
     serial_sink *s = state;
     s->in++;
     if (len == 0 || line[len - 1] != '\n' || gs_lineq_push(&s->q, line, len) != 0) {
-        s->too_long++;
+        s->bad++;
         return -1;
     }
     pump(s);
@@ -157,7 +157,7 @@ static void serial_info(const void *state, gs_sink_info *o)
     o->last_errno = s->last_errno;
     o->c.lines_in = s->in;
     o->c.lines_sent = s->r.sent;
-    o->c.lines_dropped = s->r.dropped + gs_lineq_reader_lost(&s->r, &s->q) + s->too_long;
+    o->c.lines_dropped = s->r.dropped + gs_lineq_reader_lost(&s->r, &s->q) + s->bad;
     o->c.bytes_sent = s->r.bytes;
     o->c.lines_queued = gs_lineq_reader_pending(&s->r, &s->q);
     o->c.reopens = s->reopens;
