@@ -130,8 +130,9 @@ size_t gs_sinkset_write_event(gs_sinkset *set, gs_format fmt, const gs_event *ev
 void gs_sinkset_poll(gs_sinkset *set, double now_s);
 /* Lines still queued over all sinks. */
 uint64_t gs_sinkset_pending(const gs_sinkset *set);
-/* At shutdown: poll until nothing is queued or timeout_s of the monotonic clock
- * passed, waiting a few ms between rounds. Returns the lines still queued. */
+/* At shutdown: poll until nothing is queued or timeout_s passed, waiting a few
+ * ms between rounds. It polls with gs_sink_now_s(): a caller that drains
+ * should give every poll that clock. Returns the lines still queued. */
 uint64_t gs_sinkset_drain(gs_sinkset *set, double timeout_s);
 /* The sinks as a JSON array `[{"sink":"serial","target":..,"state":..,...},...]`
  * for a status line. Returns the length, 0 if cap is too small (buf ""). */
