@@ -267,7 +267,7 @@ void test_sinkset_from_profile_fans_out_the_same_bytes(void)
     EQ_SZ(strlen(st), sn);
     TEST_ASSERT_EQUAL_INT('[', st[0]);
     TEST_ASSERT_EQUAL_INT(']', st[sn - 1]);
-    char frag[128];
+    char frag[256];
     snprintf(frag, sizeof frag, "{\"sink\":\"file\",\"target\":\"%s\",\"state\":\"up\",\"error\":null,"
              "\"lines_in\":3,\"lines_sent\":3,\"lines_dropped\":0,\"bytes_sent\":%u,", path, (unsigned)wn);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(st, frag), st);

@@ -349,12 +349,11 @@ void test_queue_overflow_drops_whole_oldest_lines(void)
     for (size_t j = 1; j < k; j++)
         TEST_ASSERT_TRUE(nums[j] > nums[j - 1]);
     TEST_ASSERT_EQUAL_UINT(N - 1, nums[k - 1]);
-    /* the lines dropped are a gap of the oldest queued: everything from the first
-     * line after the gap to the end arrived */
-    size_t gaps = 0;
-    for (size_t j = 1; j < k; j++)
-        gaps += nums[j] != nums[j - 1] + 1u;
-    EQ_SZ(1, gaps);
+    /* the oldest go: the 8 newest lines were in the queue at the end, all arrived
+     * (how many gaps there are depends on when the pty drained) */
+    TEST_ASSERT_TRUE(k >= 8);
+    for (unsigned j = 0; j < 8; j++)
+        TEST_ASSERT_EQUAL_UINT(N - 8 + j, nums[k - 8 + j]);
     TEST_ASSERT_EQUAL_UINT(0, nums[0]);
     s.close(s.state);
     close(m);
