@@ -269,6 +269,14 @@ void test_unplug_queue_and_reopen_through_symlink(void)
     TEST_ASSERT_EQUAL_UINT64(3, in.c.lines_sent);
     write_lines(&s, 3, 10); /* queued meanwhile */
     TEST_ASSERT_EQUAL_UINT64(7, info_of(&s).c.lines_queued);
+    char text[256], want[256];
+    uint64_t b3 = 0;
+    for (unsigned i = 0; i < 3; i++)
+        b3 += make_line(want, sizeof want, i);
+    snprintf(want, sizeof want, "serial %s@57600 retrying (%s): 3 sent, 0 dropped, 7 queued, %llu bytes", link,
+             strerror(EIO), (unsigned long long)b3);
+    TEST_ASSERT_TRUE(gs_sink_status_text(&s, text, sizeof text) > 0);
+    TEST_ASSERT_EQUAL_STRING(want, text);
 
     /* the device comes back under the same name */
     m = open_pty(dev, sizeof dev);

@@ -78,6 +78,8 @@ static int fd_write_line(void *state, const char *line, size_t len)
         return -1;
     }
     if (gs_out_line(&f->out, line, len) != 0) {
+        if (f->out.err == EAGAIN || f->out.err == EWOULDBLOCK)
+            f->out.err = 0; /* someone made the descriptor non-blocking: a drop, not a failure */
         f->dropped++;
         return -1;
     }
@@ -212,6 +214,25 @@ uint64_t gs_sinkset_drain(gs_sinkset *set, double timeout_s)
             return left;
         poll(NULL, 0, 5); /* let peers read */
     }
+}
+
+size_t gs_sink_status_text(const gs_sink *s, char *buf, size_t cap)
+{
+    gs_sink_info in;
+    s->info(s->state, &in);
+    char why[80] = "";
+    if (in.last_errno)
+        snprintf(why, sizeof why, " (%s)", strerror(in.last_errno));
+    int w = snprintf(buf, cap, "%s %s %s%s: %llu sent, %llu dropped, %llu queued, %llu bytes", in.kind, in.target,
+                     gs_sink_state_name(in.state), why, (unsigned long long)in.c.lines_sent,
+                     (unsigned long long)in.c.lines_dropped, (unsigned long long)in.c.lines_queued,
+                     (unsigned long long)in.c.bytes_sent);
+    if (w < 0 || (size_t)w >= cap) {
+        if (cap)
+            buf[0] = '\0';
+        return 0;
+    }
+    return (size_t)w;
 }
 
 /* append printf text at *n; false once it no longer fits */

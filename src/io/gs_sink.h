@@ -139,6 +139,10 @@ uint64_t gs_sinkset_drain(gs_sinkset *set, double timeout_s);
 size_t gs_sinkset_status_json(const gs_sinkset *set, char *buf, size_t cap);
 void gs_sinkset_close(gs_sinkset *set);
 
+/* One line of text for a person: "serial /dev/ttyUSB0@115200 retrying (Input/output
+ * error): 40 sent, 0 dropped, 2 queued, 16212 bytes". Length, 0 if cap is too small. */
+size_t gs_sink_status_text(const gs_sink *s, char *buf, size_t cap);
+
 /* Ignore SIGPIPE for the whole process (a daemon writing to pipes must). 0 or -1. */
 int gs_sink_ignore_sigpipe(void);
 

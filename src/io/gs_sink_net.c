@@ -364,8 +364,27 @@ static void tc_schedule(tcp_client_sink *s, int err)
     gs_lineq_reader_rewind(&s->r); /* a new connection starts with a whole line */
 }
 
+/* A connect to a free loopback port in the ephemeral range can meet itself
+ * (TCP simultaneous open) and would then swallow every line: treat as refused. */
+static bool self_connected(int fd)
+{
+    struct sockaddr_storage a, b;
+    socklen_t al = sizeof a, bl = sizeof b;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    if (getsockname(fd, (struct sockaddr *)&a, &al) != 0 || getpeername(fd, (struct sockaddr *)&b, &bl) != 0)
+        return false;
+    return al == bl && memcmp(&a, &b, al) == 0;
+}
+
+static void tc_schedule(tcp_client_sink *s, int err);
+
 static void tc_connected(tcp_client_sink *s)
 {
+    if (self_connected(s->fd)) {
+        tc_schedule(s, ECONNREFUSED);
+        return;
+    }
     s->st = GS_SINK_UP;
     s->connects++;
     s->backoff_s = s->cfg.backoff_min_s;
