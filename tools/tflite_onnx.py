@@ -267,9 +267,11 @@ class Converter:
         out = op.Outputs(0)
         spatial_only = len(pads) == 4 and not pads[0].any() and not pads[3].any()
         consumers = self.consumers(out)
-        foldable = spatial_only and len(consumers) == 1 and self.uses.get(out) == 1 and \
-            opcode_name(self.model, consumers[0]) in ("CONV_2D", "DEPTHWISE_CONV_2D")
-        if foldable:  # zero padding in front of a convolution = the convolution's own pads
+        is_output = any(self.g.Outputs(k) == out for k in range(self.g.OutputsLength()))
+        foldable = spatial_only and consumers and not is_output and all(
+            opcode_name(self.model, c) in ("CONV_2D", "DEPTHWISE_CONV_2D") and c.Inputs(0) == out
+            for c in consumers)
+        if foldable:  # zero padding in front of convolutions = the convolutions' own pads
             self.fold_pad[out] = (x, [int(pads[1][0]), int(pads[2][0]), int(pads[1][1]), int(pads[2][1])])
             return None, None
         if len(pads) == 4:
