@@ -153,6 +153,34 @@ class Models(unittest.TestCase):
             conv.convert_file(path("pose_landmark_lite.tflite"), out)
             self.assertEqual(sha256(out), sha256(path("pose_landmark_lite.onnx")))
 
+    def test_folded_weights_equal_the_interpreters(self):
+        """Every DENSIFY/DEQUANTIZE result the converter computes equals, bit for bit,
+        the tensor TFLite's interpreter computes for the same op."""
+        conv = self._converter()
+        for name in (DETECTOR, "pose_landmark_lite"):
+            with open(path(name + ".tflite"), "rb") as f:
+                c = conv.Converter(f.read())
+            c.convert()
+            it = Interpreter(model_path=path(name + ".tflite"), experimental_preserve_all_tensors=True,
+                             experimental_op_resolver_type=OpResolverType.BUILTIN_WITHOUT_DEFAULT_DELEGATES)
+            it.allocate_tensors()
+            inp = it.get_input_details()[0]
+            it.set_tensor(inp["index"], np.zeros(inp["shape"], np.float32))
+            it.invoke()
+            counts = {"DENSIFY": 0, "DEQUANTIZE": 0}
+            for i in range(c.g.OperatorsLength()):
+                op = c.g.Operators(i)
+                kind = conv.opcode_name(c.model, op)
+                if kind in counts:
+                    out = op.Outputs(0)
+                    ref, mine = it.get_tensor(out), c.const[out]
+                    self.assertEqual(ref.dtype, mine.dtype, c.tname(out))
+                    self.assertTrue(np.array_equal(ref, mine), "%s %s differs" % (kind, c.tname(out)))
+                    counts[kind] += 1
+            want = {DETECTOR: {"DENSIFY": 38, "DEQUANTIZE": 144},
+                    "pose_landmark_lite": {"DENSIFY": 0, "DEQUANTIZE": 176}}[name]
+            self.assertEqual(counts, want, name)
+
     def test_strict_form_is_valid_onnx(self):
         conv = self._converter()
         with tempfile.TemporaryDirectory() as tmp:

@@ -330,16 +330,16 @@ class Converter:
                       strides=[sh, sw], pads=[t, l, b, r])
         return self.activation(y, o.FusedActivationFunction(), name), "nchw"
 
-    def op_resize(self, op, opts, bilinear):
+    def op_resize(self, op, opts):
         x = op.Inputs(0)
-        o = (tflite.ResizeBilinearOptions if bilinear else tflite.ResizeNearestNeighborOptions)()
+        o = tflite.ResizeBilinearOptions()
         o.Init(opts.Bytes, opts.Pos)
         _, h, w, _ = self.shape(x)
         _, h2, w2, _ = self.shape(op.Outputs(0))
         if o.AlignCorners():
             mode = "align_corners"
-        elif o.HalfPixelCenters():
-            mode = "half_pixel" if bilinear else "tf_half_pixel_for_nn"
+        elif o.HalfPixelCenters():  # OpenCV 4.6 reads this as its own half-pixel bilinear
+            mode = "half_pixel"
         else:
             mode = "asymmetric"
         if h2 % h or w2 % w:
@@ -347,10 +347,8 @@ class Converter:
         name = self.tname(op.Outputs(0))
         roi = self.init(name + "_roi", np.zeros(0, dtype=np.float32))
         scales = self.init(name + "_scales", np.array([1, 1, h2 // h, w2 // w], dtype=np.float32))
-        attrs = dict(mode="linear" if bilinear else "nearest", coordinate_transformation_mode=mode)
-        if not bilinear:
-            attrs["nearest_mode"] = "floor"
-        return self.node("Resize", [self.get(x, "nchw"), roi, scales], name, **attrs), "nchw"
+        return self.node("Resize", [self.get(x, "nchw"), roi, scales], name, mode="linear",
+                         coordinate_transformation_mode=mode), "nchw"
 
     def op_depth_to_space(self, op, opts):
         o = tflite.DepthToSpaceOptions()
@@ -406,20 +404,9 @@ class Converter:
         elif kind == "DEQUANTIZE":
             t = self.tensor(ins[0])
             arr = self.const[ins[0]]
-            q = t.Quantization()
-            if t.Type() == TensorType.FLOAT16:
-                self.const[out] = arr.astype(np.float32)
-            elif q is not None and q.ScaleLength():
-                scale = q.ScaleAsNumpy().astype(np.float32)
-                zp = q.ZeroPointAsNumpy().astype(np.float32) if q.ZeroPointLength() else 0.0
-                axis = q.QuantizedDimension()
-                shp = [1] * arr.ndim
-                if scale.size > 1:
-                    shp[axis] = -1
-                self.const[out] = ((arr.astype(np.float32) - np.reshape(zp, shp) if np.ndim(zp) else
-                                    arr.astype(np.float32) - zp) * scale.reshape(shp)).astype(np.float32)
-            else:
-                raise ConvertError("DEQUANTIZE of type %d without quantization data" % t.Type())
+            if t.Type() != TensorType.FLOAT16:  # int8/uint8 weights do not occur in these models
+                raise ConvertError("DEQUANTIZE of type %d: only float16 is handled" % t.Type())
+            self.const[out] = arr.astype(np.float32)
         else:
             return False
         return True
@@ -478,9 +465,7 @@ class Converter:
                 elif kind == "MAX_POOL_2D":
                     res = self.op_maxpool(op, opts)
                 elif kind == "RESIZE_BILINEAR":
-                    res = self.op_resize(op, opts, True)
-                elif kind == "RESIZE_NEAREST_NEIGHBOR":
-                    res = self.op_resize(op, opts, False)
+                    res = self.op_resize(op, opts)
                 elif kind == "DEPTH_TO_SPACE":
                     res = self.op_depth_to_space(op, opts)
                 elif kind == "RESHAPE":
