@@ -30,6 +30,7 @@ if os.path.realpath(sys.prefix) != os.path.realpath(VENV):
 import hashlib  # noqa: E402
 import importlib.util  # noqa: E402
 import re  # noqa: E402
+import subprocess  # noqa: E402
 import tempfile  # noqa: E402
 import unittest  # noqa: E402
 
@@ -180,6 +181,23 @@ class Models(unittest.TestCase):
             want = {DETECTOR: {"DENSIFY": 38, "DEQUANTIZE": 144},
                     "pose_landmark_lite": {"DENSIFY": 0, "DEQUANTIZE": 176}}[name]
             self.assertEqual(counts, want, name)
+
+    def test_bad_input_is_a_clear_error(self):
+        with open(path("pose_landmark_lite.tflite"), "rb") as f:
+            head = f.read(1 << 20)
+        with tempfile.TemporaryDirectory() as tmp:
+            for name, data, says in (("cut.tflite", head, "damaged TFLite file"),
+                                     ("text.tflite", b"hello world\n", "not a TFLite flatbuffer")):
+                src = os.path.join(tmp, name)
+                with open(src, "wb") as f:
+                    f.write(data)
+                out = os.path.join(tmp, "out.onnx")
+                r = subprocess.run([sys.executable, os.path.join(TOP, "tools", "tflite_onnx.py"), src, out],
+                                   capture_output=True, text=True)
+                self.assertEqual(r.returncode, 1, r.stderr)
+                self.assertIn("tflite_onnx: %s: %s" % (src, says), r.stderr)
+                self.assertNotIn("Traceback", r.stderr)
+                self.assertFalse(os.path.exists(out))
 
     def test_strict_form_is_valid_onnx(self):
         conv = self._converter()

@@ -122,16 +122,7 @@ class Converter:
         self.const = {}    # tensor index -> numpy array
         self.act = {}      # tensor index -> (onnx name, layout 'nchw' | 'native')
         self.cache = {}    # (onnx name, wanted layout) -> onnx name
-        self.uses = {}     # tensor index -> number of consuming ops
         self.fold_pad = {}  # tensor index of a PAD output -> (input tensor, [t, l, b, r])
-        for i in range(self.g.OperatorsLength()):
-            op = self.g.Operators(i)
-            for k in range(op.InputsLength()):
-                t = op.Inputs(k)
-                self.uses[t] = self.uses.get(t, 0) + 1
-        for k in range(self.g.OutputsLength()):
-            t = self.g.Outputs(k)
-            self.uses[t] = self.uses.get(t, 0) + 1
         for i in range(self.g.TensorsLength()):
             self._load_const(i)
 
@@ -263,6 +254,8 @@ class Converter:
 
     def op_pad(self, op):
         x, p = op.Inputs(0), op.Inputs(1)
+        if p not in self.const:
+            raise ConvertError("PAD with non-constant paddings")
         pads = self.const[p].astype(np.int64).reshape(-1, 2)
         out = op.Outputs(0)
         spatial_only = len(pads) == 4 and not pads[0].any() and not pads[3].any()
@@ -304,7 +297,7 @@ class Converter:
                     c = c.transpose(NHWC_TO_NCHW)
                 elif layout == "nchw" and c.ndim == 1:  # per-channel vector broadcasts over C
                     c = c.reshape(1, -1, 1, 1)
-                elif layout == "nchw" and c.ndim not in (0,):
+                elif layout == "nchw" and c.ndim != 0:
                     raise ConvertError("broadcast of a rank-%d constant in %s" % (c.ndim, onnx_op))
                 ins.append(self.init(self.tname(out) + "_k", c))
             else:
@@ -509,8 +502,13 @@ def convert_file(src, dst, strict_clip=False, keep=None):
     with open(src, "rb") as f:
         buf = f.read()
     if buf[4:8] != b"TFL3":
-        raise ConvertError("%s: not a TFLite flatbuffer (identifier %r, want 'TFL3')" % (src, buf[4:8]))
-    model = Converter(buf, strict_clip, keep).convert()
+        raise ConvertError("not a TFLite flatbuffer (identifier %r, want 'TFL3')" % buf[4:8])
+    try:
+        model = Converter(buf, strict_clip, keep).convert()
+    except ConvertError:
+        raise
+    except Exception as e:  # a damaged flatbuffer surfaces as any error of the tflite reader
+        raise ConvertError("damaged TFLite file (%s: %s)" % (type(e).__name__, e))
     data = model.SerializeToString(deterministic=True)
     with open(dst, "wb") as f:
         f.write(data)
