@@ -7,8 +7,10 @@ MODEL is a file name in models/ without .onnx (default: the detector, the three
 landmark models and their _noseg variants). Runs in the venv .venv/ (Debian's
 cv2, the same library as the C++ build). One frame = setInput + forward of every
 graph output on a fixed random input; the median and the fastest of --runs
-frames are printed, with the machine's load average, since other processes on
-the same cores slow the numbers down.
+frames are printed (wall clock), with the median CPU time of the process per
+frame (all its threads) and the machine's load average: other processes on the
+same cores stretch the wall clock, while the one-thread CPU time stays close to
+the cost of the network itself.
 """
 import argparse
 import os
@@ -39,14 +41,15 @@ def bench(name, threads, runs, warmup):
     side = 224 if "detection" in name else 256
     x = np.random.default_rng(0).uniform(0, 1, (1, 3, side, side)).astype(np.float32)
     outs = net.getUnconnectedOutLayersNames()
-    times = []
+    wall, cpu = [], []
     for i in range(warmup + runs):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         net.setInput(x)
         net.forward(outs)
         if i >= warmup:
-            times.append((time.perf_counter() - t0) * 1e3)
-    return float(np.median(times)), float(min(times))
+            wall.append((time.perf_counter() - t0) * 1e3)
+            cpu.append((time.process_time() - c0) * 1e3)
+    return float(np.median(wall)), float(min(wall)), float(np.median(cpu))
 
 
 def main():
@@ -58,11 +61,11 @@ def main():
     a = ap.parse_args()
     print("OpenCV %s, %d cores, load average before: %s" % (
         cv2.__version__, os.cpu_count(), " ".join("%.2f" % v for v in os.getloadavg())))
-    print("%-28s %7s %12s %10s" % ("model", "threads", "median ms", "best ms"))
+    print("%-28s %7s %12s %10s %12s" % ("model", "threads", "median ms", "best ms", "CPU ms"))
     for th in [int(t) for t in a.threads.split(",")]:
         for m in a.models:
-            med, best = bench(m, th, a.runs, a.warmup)
-            print("%-28s %7d %12.1f %10.1f" % (m, th, med, best))
+            med, best, cpu = bench(m, th, a.runs, a.warmup)
+            print("%-28s %7d %12.1f %10.1f %12.1f" % (m, th, med, best, cpu))
     print("load average after: %s" % " ".join("%.2f" % v for v in os.getloadavg()))
 
 
