@@ -13,10 +13,10 @@ initializers and emits an NCHW graph:
     layout only where a layout-blind op (RESHAPE, a graph output) needs it, so
     every graph output keeps TFLite's name, shape and element order.
 OpenCV 4.6 quirks handled: Clip takes min/max as attributes (its importer
-rejects Clip with inputs; --strict-clip writes the opset-11 form with inputs,
-which onnx.checker and onnxruntime accept but OpenCV 4.6 does not), no GatherND
-is used, explicit PAD in front of a VALID convolution is folded into the
-convolution's own pads.  Output is deterministic: same input, same bytes.
+rejects Clip with inputs; --strict-clip writes the spec-valid opset-11 form
+with inputs, which onnx.checker accepts and OpenCV 4.6 does not), no GatherND
+is used, a zero PAD read only by convolutions is folded into their own pads.
+Output is deterministic: same input and package pins, same bytes.
 """
 import argparse
 import sys
@@ -520,7 +520,7 @@ def main(argv):
     ap.add_argument("src")
     ap.add_argument("dst", nargs="?")
     ap.add_argument("--strict-clip", action="store_true",
-                    help="opset-11 Clip with min/max inputs (onnx.checker/onnxruntime; not OpenCV 4.6)")
+                    help="spec-valid opset-11 Clip with min/max inputs (onnx.checker; not OpenCV 4.6)")
     ap.add_argument("--outputs", help="comma-separated output names to keep (default: all)")
     ap.add_argument("--list-ops", action="store_true", help="print the TFLite ops used and exit")
     a = ap.parse_args(argv)
