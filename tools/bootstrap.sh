@@ -10,8 +10,10 @@ BUILD_DIR=${BUILD_DIR:-build}
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 
-# OpenCV and libavformat for the video command (tests render clips with them)
-pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev)
+# OpenCV and libavformat for the video command (tests render clips with them);
+# python3-opencv, python3-venv and opencv-doc for the pose models' converter and its test
+pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev
+      python3-opencv python3-venv opencv-doc)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
@@ -23,6 +25,7 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 bash tools/fetch_unity.sh
+bash tools/fetch_models.sh   # BlazePose: npm package -> ONNX in models/ (checksummed)
 
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build "$BUILD_DIR" -j "$(nproc)"
