@@ -25,7 +25,7 @@ typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 typedef struct {
     const gs_core_config *cfg;
     const gs_ring *ring;
-    float *scratch_w;          /* ring->capacity floats */
+    uint32_t *keep;            /* ring->capacity bits: the robust fits' inlier flags */
     gs_event_fn on_event;
     void *ctx;
     bool trace;
@@ -79,10 +79,13 @@ typedef struct {
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
-                         float *scratch_w, bool rigid, gs_event_fn on_event, void *ctx);
+                         uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx);
 /* Examine every sample pushed to the ring since the last call. Emits GS_EV_JUMP
  * events through on_event (and trace events when f->trace). */
 void gs_flight_update(gs_flight *f);
+/* The stream pauses longer than the ring's time span (GS_RING_SPAN_US): close
+ * an open candidate now, while the ring still holds its samples. */
+void gs_flight_break(gs_flight *f);
 /* End of stream: close any open candidate. */
 void gs_flight_finish(gs_flight *f);
 

@@ -3,6 +3,7 @@
 #include "gravscale/gs_fit.h"
 
 #include <math.h>
+#include <string.h>
 
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
@@ -225,18 +226,49 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
     return xorshift32(state) % n;
 }
 
-static bool sample_usable(const gs_sample *s)
+/* What a fit reads of a ring sample, unpacked. */
+typedef struct {
+    double t_s;
+    float x_px, y_px, w;
+} gs_fsamp;
+
+/* Window sample i unpacked into *buf; NULL when the ring no longer holds it. */
+static const gs_fsamp *win_at(const gs_ring *ring, uint64_t idx, gs_fsamp *buf)
 {
-    return s && s->w > 0.0f && isfinite(s->w) && isfinite(s->t_s) && isfinite(s->x_px) && isfinite(s->y_px);
+    const gs_sample *s = gs_ring_at(ring, idx);
+    if (!s) {
+        return NULL;
+    }
+    buf->t_s = gs_ring_sample_t_s(ring, s);
+    buf->x_px = s->x_px;
+    buf->y_px = s->y_px;
+    buf->w = gs_sample_w(s);
+    return buf;
 }
 
-static double win_tau(const gs_win *wn, const gs_sample *s)
+static bool sample_usable(const gs_fsamp *s)
+{
+    return s && s->w > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
+}
+
+bool gs_fit_kept(const uint32_t *keep, uint32_t i)
+{
+    return keep && ((keep[i >> 5] >> (i & 31u)) & 1u) != 0u;
+}
+
+static void keep_set(uint32_t *keep, uint32_t i, bool on)
+{
+    uint32_t bit = 1u << (i & 31u);
+    keep[i >> 5] = on ? (keep[i >> 5] | bit) : (keep[i >> 5] & ~bit);
+}
+
+static double win_tau(const gs_win *wn, const gs_fsamp *s)
 {
     return (s->t_s - wn->t0_s) / wn->tscale_s;
 }
 
 /* Squared 2D distance of a sample from the parabola, in px^2. */
-static double resid2(const gs_par *p, double tau, const gs_sample *s)
+static double resid2(const gs_par *p, double tau, const gs_fsamp *s)
 {
     double ex = (double)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
     double ey = (double)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
@@ -244,13 +276,13 @@ static double resid2(const gs_par *p, double tau, const gs_sample *s)
 }
 
 /* 2D distance of a sample from the parabola, in px. */
-static double resid_norm(const gs_par *p, double tau, const gs_sample *s)
+static double resid_norm(const gs_par *p, double tau, const gs_fsamp *s)
 {
     return sqrt(resid2(p, tau, s));
 }
 
 /* The parabola through three samples (Newton divided differences); false when two times coincide. */
-static bool par_through(const gs_win *wn, const gs_sample *a, const gs_sample *b, const gs_sample *c, gs_par *p)
+static bool par_through(const gs_win *wn, const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
 {
     double ta = win_tau(wn, a), tb = win_tau(wn, b), tc = win_tau(wn, c);
     double dab = tb - ta, dac = tc - ta, dbc = tc - tb;
@@ -277,56 +309,44 @@ static bool par_through(const gs_win *wn, const gs_sample *a, const gs_sample *b
     return true;
 }
 
-/* k-th smallest of v[0..n) (k < n), reordering v in place (Hoare selection). */
-static float select_kth(float *v, uint32_t n, uint32_t k)
+/* Median residual norm of the usable samples, without storage: a radix
+ * selection of the lower median over the bit patterns of the squared residuals
+ * as floats (non-negative floats order like their bits), 4 bits a pass. The
+ * same float is found as by sorting them. */
+static double median_resid(const gs_win *wn, const gs_par *p)
 {
-    int32_t lo = 0, hi = (int32_t)n - 1, kk = (int32_t)k;
-    while (lo < hi) {
-        float pivot = v[lo + (hi - lo) / 2];
-        int32_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] < pivot) {
-                i++;
-            }
-            while (v[j] > pivot) {
-                j--;
-            }
-            if (i <= j) {
-                float tmp = v[i];
-                v[i] = v[j];
-                v[j] = tmp;
-                i++;
-                j--;
-            }
-        }
-        /* Now v[lo..j] <= pivot <= v[i..hi] and anything between equals the pivot. */
-        if (kk <= j) {
-            hi = j;
-        } else if (kk >= i) {
-            lo = i;
-        } else {
-            return v[kk];
-        }
-    }
-    return v[kk];
-}
-
-/* Median residual norm of the usable samples, using tmp (count floats) as storage. */
-static double median_resid(const gs_win *wn, const gs_par *p, float *tmp)
-{
-    uint32_t i, m = 0;
-    for (i = 0; i < wn->count; i++) {
-        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
-        if (sample_usable(s)) {
-            /* Squares order like norms: one sqrt for the median instead of one per sample. */
-            tmp[m++] = (float)resid2(p, win_tau(wn, s), s);
-        }
-    }
-    if (m == 0) {
+    uint32_t prefix = 0, mask = 0, k, i;
+    int shift;
+    float v;
+    if (wn->m == 0) {
         return (double)NAN;
     }
-    /* Lower median: exact for odd m, robust enough for even m. */
-    return sqrt((double)select_kth(tmp, m, (m - 1) / 2));
+    k = (wn->m - 1) / 2; /* lower median: exact for odd m, robust enough for even m */
+    for (shift = 28; shift >= 0; shift -= 4) {
+        uint32_t cnt[16] = {0};
+        uint32_t d = 0;
+        for (i = 0; i < wn->count; i++) {
+            gs_fsamp sb;
+            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+            if (sample_usable(s)) {
+                /* squares order like norms: one sqrt for the median instead of one per sample */
+                float r2 = (float)resid2(p, win_tau(wn, s), s);
+                uint32_t key;
+                memcpy(&key, &r2, sizeof key);
+                if ((key & mask) == prefix) {
+                    cnt[(key >> (uint32_t)shift) & 15u]++;
+                }
+            }
+        }
+        while (d < 15u && k >= cnt[d]) {
+            k -= cnt[d];
+            d++;
+        }
+        prefix |= d << (uint32_t)shift;
+        mask |= 15u << (uint32_t)shift;
+    }
+    memcpy(&v, &prefix, sizeof v);
+    return sqrt((double)v);
 }
 
 /* Tukey biweight of a residual norm r with cut-off cut. */
@@ -344,7 +364,7 @@ static double tukey(double r, double cut)
 /* Final weight of one sample under a model: prior * robust factor, as a float. */
 typedef enum { W_PRIOR, W_TUKEY, W_INLIER } w_mode;
 
-static float sample_weight(const gs_win *wn, const gs_sample *s, const gs_par *p, w_mode mode, double cut)
+static float sample_weight(const gs_win *wn, const gs_fsamp *s, const gs_par *p, w_mode mode, double cut)
 {
     double r;
     if (!sample_usable(s)) {
@@ -360,8 +380,8 @@ static float sample_weight(const gs_win *wn, const gs_sample *s, const gs_par *p
     return (float)((double)s->w * tukey(r, cut));
 }
 
-/* Weighted LS over the window; writes each sample's weight to w_out, the tau-basis parabola to p. */
-static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, double cut, float *w_out,
+/* Weighted LS over the window; flags each sample with a positive weight in keep, the tau-basis parabola to p. */
+static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, double cut, uint32_t *keep,
                             gs_par *p, gs_fit_result *out)
 {
     gs_fit f;
@@ -369,9 +389,10 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     uint32_t i;
     gs_fit_init(&f, wn->t0_s, wn->tscale_s);
     for (i = 0; i < wn->count; i++) {
-        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+        gs_fsamp sb;
+        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
         float w = sample_weight(wn, s, model, mode, cut);
-        w_out[i] = w;
+        keep_set(keep, i, w > 0.0f);
         if (w > 0.0f) {
             gs_fit_add(&f, s->t_s, s->x_px, s->y_px, (double)w);
         }
@@ -392,7 +413,8 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
         return k; /* the common case: no scan needed */
     }
     for (i = 0; i < wn->count; i++) {
-        if (sample_usable(gs_ring_at(wn->ring, wn->first + i))) {
+        gs_fsamp sb;
+        if (sample_usable(win_at(wn->ring, wn->first + i, &sb))) {
             if (k == 0) {
                 return i;
             }
@@ -406,7 +428,7 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
  * from each third of the usable samples (well spread in time, so the exact
  * parabola is well conditioned), keep the one with the smallest median
  * residual. Tolerates almost half the samples being gross outliers. */
-static bool lmeds_start(const gs_win *wn, uint32_t m, float *tmp, gs_par *best, double *best_med)
+static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, double *best_med)
 {
     uint32_t state = GS_FIT_SEED_IRLS;
     uint32_t third = m / 3, k;
@@ -416,15 +438,16 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, float *tmp, gs_par *best, 
         uint32_t ka = rand_below(&state, third);
         uint32_t kb = third + rand_below(&state, third);
         uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
-        const gs_sample *a = gs_ring_at(wn->ring, wn->first + usable_index(wn, ka));
-        const gs_sample *b = gs_ring_at(wn->ring, wn->first + usable_index(wn, kb));
-        const gs_sample *c = gs_ring_at(wn->ring, wn->first + usable_index(wn, kc));
+        gs_fsamp ab, bb, cb;
+        const gs_fsamp *a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
+        const gs_fsamp *b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
+        const gs_fsamp *c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
         gs_par p;
         double med;
         if (!par_through(wn, a, b, c, &p)) {
             continue;
         }
-        med = median_resid(wn, &p, tmp);
+        med = median_resid(wn, &p);
         if (med < *best_med) {
             *best_med = med;
             *best = p;
@@ -455,7 +478,7 @@ static double par_max_shift_px(const gs_par *a, const gs_par *b)
 }
 
 /* Tukey biweight IRLS from a start; *fin receives the converged curve. */
-static gs_status irls_from(const gs_win *wn, gs_par cur, double floor_px, float *scratch_w,
+static gs_status irls_from(const gs_win *wn, gs_par cur, double floor_px, uint32_t *keep,
                            gs_fit_result *out, gs_par *fin)
 {
     gs_par next;
@@ -463,13 +486,13 @@ static gs_status irls_from(const gs_win *wn, gs_par cur, double floor_px, float 
     int it;
     gs_status st;
     for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
-        med = median_resid(wn, &cur, scratch_w);
+        med = median_resid(wn, &cur);
         /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
         scale = GS_FIT_MAD_K * med;
         if (!(scale >= floor_px)) {
             scale = floor_px;
         }
-        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, scratch_w, &next, out);
+        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
         if (st != GS_OK) {
             return st;
         }
@@ -491,7 +514,8 @@ static double tukey_loss(const gs_win *wn, const gs_par *p, double floor_px)
     double cut = GS_FIT_TUKEY_C * floor_px, loss = 0.0;
     uint32_t i;
     for (i = 0; i < wn->count; i++) {
-        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+        gs_fsamp sb;
+        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
         double u;
         if (!sample_usable(s)) {
             continue;
@@ -505,33 +529,33 @@ static double tukey_loss(const gs_win *wn, const gs_par *p, double floor_px)
 /* IRLS from two starts, the least-median-of-squares one (survives many gross
  * outliers) and the plain weighted fit (on clean data a few samples can fit a
  * chance subset better than all of them): the smaller robust loss wins. */
-static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, uint32_t *keep, gs_fit_result *out)
 {
     gs_par lms, plain, fin_lms, fin_plain;
     double med;
-    bool have_lms = lmeds_start(wn, m, scratch_w, &lms, &med);
-    bool have_plain = window_fit(wn, NULL, W_PRIOR, 0.0, scratch_w, &plain, out) == GS_OK;
+    bool have_lms = lmeds_start(wn, m, &lms, &med);
+    bool have_plain = window_fit(wn, NULL, W_PRIOR, 0.0, keep, &plain, out) == GS_OK;
     double loss_lms = (double)INFINITY, loss_plain = (double)INFINITY;
     if (!have_lms && !have_plain) {
         return GS_EINVAL;
     }
-    if (have_lms && irls_from(wn, lms, floor_px, scratch_w, out, &fin_lms) == GS_OK) {
+    if (have_lms && irls_from(wn, lms, floor_px, keep, out, &fin_lms) == GS_OK) {
         loss_lms = tukey_loss(wn, &fin_lms, floor_px);
     }
-    if (have_plain && irls_from(wn, plain, floor_px, scratch_w, out, &fin_plain) == GS_OK) {
+    if (have_plain && irls_from(wn, plain, floor_px, keep, out, &fin_plain) == GS_OK) {
         loss_plain = tukey_loss(wn, &fin_plain, floor_px);
     }
     if (!(loss_plain <= loss_lms)) {
         if (!(loss_lms < (double)INFINITY)) {
             return GS_EINVAL;
         }
-        /* the LMS run won: run it again so scratch_w and out hold its weights */
-        return irls_from(wn, lms, floor_px, scratch_w, out, &fin_lms);
+        /* the LMS run won: run it again so keep and out hold its weights */
+        return irls_from(wn, lms, floor_px, keep, out, &fin_lms);
     }
     return GS_OK;
 }
 
-static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, uint32_t *keep, gs_fit_result *out)
 {
     uint32_t state = GS_FIT_SEED_RANSAC;
     double thr = 3.0 * floor_px;
@@ -543,21 +567,23 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float
         uint32_t ka = rand_below(&state, m);
         uint32_t kb = rand_below(&state, m);
         uint32_t kc = rand_below(&state, m);
-        const gs_sample *a, *b, *c;
+        gs_fsamp ab, bb, cb;
+        const gs_fsamp *a, *b, *c;
         gs_par p;
         uint32_t n_in = 0;
         double cost = 0.0;
         if (ka == kb || ka == kc || kb == kc) {
             continue;
         }
-        a = gs_ring_at(wn->ring, wn->first + usable_index(wn, ka));
-        b = gs_ring_at(wn->ring, wn->first + usable_index(wn, kb));
-        c = gs_ring_at(wn->ring, wn->first + usable_index(wn, kc));
+        a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
+        b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
+        c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
         if (!par_through(wn, a, b, c, &p)) {
             continue;
         }
         for (i = 0; i < wn->count; i++) {
-            const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+            gs_fsamp sb;
+            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
             double r2;
             if (!sample_usable(s)) {
                 continue;
@@ -579,11 +605,11 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float
     if (!found) {
         return GS_EINVAL;
     }
-    return window_fit(wn, &best, W_INLIER, thr, scratch_w, NULL, out);
+    return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out);
 }
 
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
-                        float min_scale_px, float *scratch_w, gs_fit_result *out)
+                        float min_scale_px, uint32_t *keep, gs_fit_result *out)
 {
     gs_win wn;
     double t_min = (double)INFINITY, t_max = -(double)INFINITY;
@@ -596,14 +622,15 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     out->t0_s = (double)NAN;
     out->n = 0;
     nan_result(out);
-    if (!ring || !scratch_w || count == 0) {
+    if (!ring || !keep || count == 0) {
         return GS_EINVAL;
     }
     for (i = 0; i < count; i++) {
-        scratch_w[i] = 0.0f;
+        keep_set(keep, i, false);
     }
     for (i = 0; i < count; i++) {
-        const gs_sample *s = gs_ring_at(ring, first + i);
+        gs_fsamp sb;
+        const gs_fsamp *s = win_at(ring, first + i, &sb);
         if (!s) {
             /* Overwritten or not yet written: the window is gone. */
             return GS_EINVAL;
@@ -632,13 +659,13 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
 
     switch (method) {
     case GS_FIT_PLAIN:
-        st = window_fit(&wn, NULL, W_PRIOR, 0.0, scratch_w, NULL, out);
+        st = window_fit(&wn, NULL, W_PRIOR, 0.0, keep, NULL, out);
         break;
     case GS_FIT_IRLS:
-        st = fit_irls(&wn, m, floor_px, scratch_w, out);
+        st = fit_irls(&wn, m, floor_px, keep, out);
         break;
     case GS_FIT_RANSAC:
-        st = fit_ransac(&wn, m, floor_px, scratch_w, out);
+        st = fit_ransac(&wn, m, floor_px, keep, out);
         break;
     default:
         st = GS_EINVAL;
@@ -646,12 +673,12 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     }
     if (st != GS_OK) {
         for (i = 0; i < count; i++) {
-            scratch_w[i] = 0.0f;
+            keep_set(keep, i, false);
         }
         return st;
     }
     for (i = 0; i < count; i++) {
-        if (scratch_w[i] > 0.0f) {
+        if (gs_fit_kept(keep, i)) {
             n_pos++;
         }
     }

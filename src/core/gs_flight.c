@@ -48,16 +48,35 @@
 #define STAND_SETTLE_S   0.2    /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      2.0    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
-static const gs_sample *at(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i); }
+/* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
+static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
+{
+    return gs_ring_get(f->ring, i, buf) ? buf : NULL;
+}
+
+/* time of ring sample i, NaN when not held */
+static double t_at(const gs_flight *f, uint64_t i)
+{
+    const gs_sample *s = gs_ring_at(f->ring, i);
+    return s ? gs_ring_sample_t_s(f->ring, s) : NAN;
+}
 
 /* Frames that weigh almost nothing (the COM lacks a whole segment, e.g. the head
  * out of the frame at the apex) take no part in detecting flights either. */
-static bool usable(const gs_sample *s)
+static bool usable(const gs_sample_full *s)
 {
     return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
 }
 
-static double u_of(const gs_flight *f, const gs_sample *s)
+static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
+
+static bool usable_at(const gs_flight *f, uint64_t i)
+{
+    gs_sample_full b;
+    return usable(at(f, i, &b));
+}
+
+static double u_of(const gs_flight *f, const gs_sample_full *s)
 {
     return (double)s->x_px * f->up_x + (double)s->y_px * f->up_y;
 }
@@ -130,13 +149,13 @@ static double med3(double a, double b, double c)
 }
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
-                         float *scratch_w, bool rigid, gs_event_fn on_event, void *ctx)
+                         uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
-    if (!f || !cfg || !ring || !scratch_w) return GS_EINVAL;
+    if (!f || !cfg || !ring || !keep) return GS_EINVAL;
     memset(f, 0, sizeof *f);
     f->cfg = cfg;
     f->ring = ring;
-    f->scratch_w = scratch_w;
+    f->keep = keep;
     f->rigid = rigid;
     f->on_event = on_event;
     f->ctx = ctx;
@@ -197,7 +216,7 @@ static double pred_var_factor(const gs_fit *fit, double t_s)
  * the deviation against gravity in units of its standard deviation (contact
  * pushes the body above the parabola, so z grows quadratically after it). */
 static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
-                        const gs_sample *s, double *z)
+                        const gs_sample_full *s, double *z)
 {
     double dt = s->t_s - r->t0_s;
     double px = r->x0_px + r->vx_px_s * dt + 0.5 * r->ax_px_s2 * dt * dt;
@@ -259,7 +278,8 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double si
 static double gate_size(const gs_flight *f, uint64_t idx)
 {
     if (f->rigid) {
-        const gs_sample *s = at(f, idx);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, idx, &s_b);
         return s && isfinite(s->size_px) ? (double)s->size_px : NAN;
     }
     double se;
@@ -269,18 +289,20 @@ static double gate_size(const gs_flight *f, uint64_t idx)
 /* Rebuild the running fit robustly from the ring samples [lo, hi]. */
 static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
 {
-    const gs_sample *a = at(f, lo), *b = at(f, hi);
+    gs_sample_full a_b, b_b;
+    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
     if (!a || !b || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     gs_fit_result r;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->scratch_w, &r) != GS_OK)
+    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, &r) != GS_OK)
         return false;
     double tspan = b->t_s - a->t_s;
     gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
-        const gs_sample *s = at(f, i);
-        if (usable(s) && f->scratch_w[i - lo] > 0.0f) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
+        if (usable(s) && gs_fit_kept(f->keep, (uint32_t)(i - lo))) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
     }
     gs_fit_result chk;
     return gs_fit_solve(&f->fit, &chk) == GS_OK;
@@ -298,7 +320,8 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     if (r.rms_px / sqrt(2.0) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         double z;
         if (usable(s)) {
             if (test_sample(f, &f->fit, &r, s, &z)) {
@@ -323,7 +346,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
         uint32_t n = 0;
-        for (uint64_t i = lo; i <= hi; i++) n += usable(at(f, i)) ? 1u : 0u;
+        for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i) ? 1u : 0u;
         if (n >= 5) break;
         if (lo > f->quiet_from && lo > oldest) lo--;
         if (hi < newest) hi++;
@@ -331,7 +354,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
     uint32_t n_usable = 0;
-    for (uint64_t i = lo; i <= hi; i++) n_usable += usable(at(f, i)) ? 1u : 0u;
+    for (uint64_t i = lo; i <= hi; i++) n_usable += usable_at(f, i) ? 1u : 0u;
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
@@ -398,7 +421,8 @@ static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double
 {
     double A[4][4] = {{0}}, b[4] = {0}, yy = 0.0;
     for (uint64_t i = lo; i <= hi; i++) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         double z;
         if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
         double w = (double)s->w;
@@ -438,8 +462,10 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
                               double alpha_max_px, double t_grown, double penalty,
                               const gs_fit_result *r)
 {
-    const gs_sample *a = at(f, lo), *b = at(f, hi);
-    const gs_sample *ei = at(f, edge_in), *eo = at(f, edge_out);
+    gs_sample_full a_b, b_b;
+    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
+    gs_sample_full ei_b, eo_b;
+    const gs_sample_full *ei = at(f, edge_in, &ei_b), *eo = at(f, edge_out, &eo_b);
     if (!a || !b || !ei || !eo) return NAN;
     double tc = 0.5 * (a->t_s + b->t_s), ts = 0.5 * (b->t_s - a->t_s);
     if (!(ts > 0.0)) return NAN;
@@ -496,7 +522,8 @@ static double rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, double *s
     uint32_t n = 0;
     uint64_t step = (hi - lo + MEDIAN_MAX) / MEDIAN_MAX;
     for (uint64_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (s && isfinite(s->size_px) && s->size_px > 0.0f) v[n++] = s->size_px;
     }
     return median_se(v, n, se_out);
@@ -514,14 +541,17 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     double S = 0.0;
     uint64_t oldest = gs_ring_oldest(f->ring);
     uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
-    const gs_sample *first = at(f, f->fl_first);
+    gs_sample_full first_b;
+    const gs_sample_full *first = at(f, f->fl_first, &first_b);
     double t_prev = first ? first->t_s : NAN;
-    const gs_sample *sd = at(f, f->seed_idx);
+    gs_sample_full sd_b;
+    const gs_sample_full *sd = at(f, f->seed_idx, &sd_b);
     uint64_t clean = f->fl_first;
     uint64_t i = f->fl_first;
     while (i > floor_idx) {
         i--;
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (!s) break;
         if (!usable(s)) continue;
         if (t_prev - s->t_s > max_gap) break;
@@ -575,7 +605,8 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
     while (n < CONTACT_SAMPLES_MAX) {
         if (side < 0) { if (i <= floor_idx) break; i--; }
         else { if (i + 1 >= head) break; i++; }
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (!usable(s)) continue;
         double z;
         if (!test_sample(f, &f->fit, r, s, &z)) continue;  /* a glitch: look past it */
@@ -614,7 +645,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
     double T0 = NAN, T1 = NAN;
     /* a flight longer than the ring holds has lost its edges: no refinement */
-    if (!at(f, L) || !at(f, R) || !at(f, lo) || !at(f, hi) || !at(f, first_left) || !at(f, first_right))
+    if (!held(f, L) || !held(f, R) || !held(f, lo) || !held(f, hi) || !held(f, first_left) || !held(f, first_right))
         n_left = n_right = 0;
     double amin = CONTACT_MIN_G * r.a_px_s2;
     double sig = fit_sigma(f, &r);
@@ -622,52 +653,56 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n_left >= 2)
-        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, at(f, L)->t_s, pen, &r);
+        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, t_at(f, L), pen, &r);
     else if (n_left == 1)
-        T0 = 0.5 * (at(f, first_left)->t_s + at(f, L)->t_s);
+        T0 = 0.5 * (t_at(f, first_left) + t_at(f, L));
     if (n_right >= 2)
-        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, at(f, R)->t_s, pen, &r);
+        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, t_at(f, R), pen, &r);
     else if (n_right == 1)
-        T1 = 0.5 * (at(f, first_right)->t_s + at(f, R)->t_s);
+        T1 = 0.5 * (t_at(f, first_right) + t_at(f, R));
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         n_left, n_right, T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
     uint64_t in_lo = lo, in_hi = hi;
     while (in_lo < in_hi) {
-        const gs_sample *s = at(f, in_lo);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, in_lo, &s_b);
         if (s && (!isfinite(T0) ? in_lo >= L : s->t_s > T0)) break;
         in_lo++;
     }
     while (in_hi > in_lo) {
-        const gs_sample *s = at(f, in_hi);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, in_hi, &s_b);
         if (s && (!isfinite(T1) ? in_hi <= R : s->t_s < T1)) break;
         in_hi--;
     }
     f->up_x = save_ux;
     f->up_y = save_uy;
 
-    const gs_sample *sf = at(f, in_lo), *sl = at(f, in_hi);
+    gs_sample_full sf_b, sl_b;
+    const gs_sample_full *sf = at(f, in_lo, &sf_b), *sl = at(f, in_hi, &sl_b);
     if (!sf || !sl || in_hi < in_lo) goto done;
     land_idx = in_hi + 1;
     uint32_t count = (uint32_t)(in_hi - in_lo + 1);
     gs_fit_result fr;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
-                                 f->scratch_w, &fr);
+                                 f->keep, &fr);
     trace_fit(f, "final", sf->t_s, sl->t_s, st == GS_OK ? &fr : NULL);
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
     double max_gap_in = 0.0, t_prev = NAN;
     for (uint64_t i = in_lo; i <= in_hi; i++) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (!s || !(s->w > 0.0f) || !isfinite(s->t_s)) continue;  /* frames missing from the source */
         if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
-        if (st == GS_OK && !(f->scratch_w[i - in_lo] > 0.0f)) n_out++;
+        if (st == GS_OK && !gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
@@ -767,7 +802,8 @@ done:
     if (land_idx != UINT64_MAX && land_idx < newest) f->quiet_from = land_idx;
     {
         /* next seeds start after the landing: restart the level trackers */
-        const gs_sample *s = at(f, newest);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, newest, &s_b);
         double u = s ? u_of(f, s) : NAN;
         f->blk_min_cur = isfinite(u) ? u : INFINITY;
         f->blk_min_prev = f->blk_min_cur;
@@ -779,20 +815,21 @@ done:
 
 /* ---- the per-sample state machine ------------------------------------------ */
 
-static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s);
+static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s);
 
 /* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
-static double speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample *s, double u)
+static double speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, double u)
 {
     uint64_t k = (uint64_t)ceil(0.1 / frame_dt(f));
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
-    const gs_sample *b = at(f, idx - k);
+    gs_sample_full b_b;
+    const gs_sample_full *b = at(f, idx - k, &b_b);
     if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
     return fabs(u - u_of(f, b)) / (s->t_s - b->t_s);
 }
 
-static void update_standing(gs_flight *f, const gs_sample *s, double speed)
+static void update_standing(gs_flight *f, const gs_sample_full *s, double speed)
 {
     if (!isfinite(speed)) return;
     if (f->rigid || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
@@ -822,7 +859,7 @@ static void update_standing(gs_flight *f, const gs_sample *s, double speed)
     }
 }
 
-static double size_ref(const gs_flight *f, const gs_sample *s)
+static double size_ref(const gs_flight *f, const gs_sample_full *s)
 {
     if (f->stand_n > 0) {
         uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
@@ -831,7 +868,7 @@ static double size_ref(const gs_flight *f, const gs_sample *s)
     return (isfinite(s->size_px) && s->size_px > 0.0f) ? (double)s->size_px : NAN;
 }
 
-static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
+static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     /* history for the median of three and second differences */
     if (f->n_hist == 3) {
@@ -906,13 +943,14 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
         set_state(f, GS_FS_AIRBORNE, apex_t);
         /* samples after the core that arrived meanwhile are tested in order */
         for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
-            const gs_sample *p = at(f, i);
+            gs_sample_full p_b;
+            const gs_sample_full *p = at(f, i, &p_b);
             if (usable(p)) airborne_sample(f, i, p);
         }
     }
 }
 
-static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample *s)
+static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_full *s)
 {
     /* the running fit may hold samples past the edge: rebuild it over the flight */
     refit_range(f, f->fl_first, f->fl_last);
@@ -920,11 +958,12 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample *s)
     set_state(f, GS_FS_GROUND, s->t_s);
 }
 
-static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
+static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
-    const gs_sample *seed = at(f, f->seed_idx);
+    gs_sample_full seed_b;
+    const gs_sample_full *seed = at(f, f->seed_idx, &seed_b);
     if (gs_fit_solve(&f->fit, &r) != GS_OK ||
         (seed && s->t_s - seed->t_s > (double)f->cfg->max_flight_s)) {
         land(f, idx, UINT64_MAX, s);
@@ -946,7 +985,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    const gs_sample *edge = at(f, f->fl_last);
+    gs_sample_full edge_b;
+    const gs_sample_full *edge = at(f, f->fl_last, &edge_b);
     if (f->cusum > 0.0 && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
         land(f, idx, idx, s);
         return;
@@ -965,7 +1005,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     if (f->cusum == 0.0) {
         /* everything pending was flight after all: take it in */
         for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
-            const gs_sample *p = at(f, j);
+            gs_sample_full p_b;
+            const gs_sample_full *p = at(f, j, &p_b);
             if (usable(p) && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
                 gs_fit_add(&f->fit, p->t_s, p->x_px, p->y_px, p->w);
         }
@@ -981,7 +1022,8 @@ void gs_flight_update(gs_flight *f)
     if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */
     while (f->next < head) {
         uint64_t idx = f->next++;
-        const gs_sample *s = at(f, idx);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
         bool present = s && s->w > 0.0f && isfinite(s->t_s);
@@ -1009,6 +1051,16 @@ void gs_flight_update(gs_flight *f)
         if (f->state == GS_FS_IDLE) set_state(f, GS_FS_GROUND, s->t_s);
         if (f->state == GS_FS_AIRBORNE) airborne_sample(f, idx, s);
         else ground_sample(f, idx, s);
+    }
+}
+
+void gs_flight_break(gs_flight *f)
+{
+    gs_flight_update(f);
+    /* what the next sample would do on seeing the gap, while the ring still holds the flight */
+    if (f->state == GS_FS_AIRBORNE) {
+        close_candidate(f, f->last_idx, UINT64_MAX, true);
+        set_state(f, GS_FS_GROUND, f->last_t_s);
     }
 }
 
