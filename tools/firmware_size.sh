@@ -1,0 +1,115 @@
+#!/bin/sh
+# firmware_size.sh - build the core for a Cortex-M4F (cmake/cortex-m4.cmake: Debian's
+# gcc-arm-none-eabi + libnewlib-arm-none-eabi, newlib nano) with the firmware link test
+# tools/fw/fw_main.c, check that no heap, stdio or strtod code is linked, and report the
+# sizes against the budgets of issue 5.
+#   tools/firmware_size.sh [BUILD_DIR]        (default build-m4)
+# Exit 0: built, no forbidden symbol, state within budget. 1: a check failed.
+# 2: no cross compiler or the build failed. The code target (24 KB) is reported, and
+# enforced only with GS_FW_STRICT=1 (docs/firmware.md says where the bytes are).
+set -eu
+top=$(cd "$(dirname "$0")/.." && pwd)
+bdir=${1:-$top/build-m4}
+case $bdir in /*) ;; *) bdir=$(pwd)/$bdir ;; esac
+
+CODE_TARGET=24576      # flash: text + data (initialisers)
+STATE_BUDGET=2048      # RAM beyond the ring: pipeline state + scratch
+RING_SAMPLES=512
+
+for t in arm-none-eabi-gcc arm-none-eabi-nm arm-none-eabi-size cmake; do
+  command -v $t >/dev/null 2>&1 || { echo "firmware_size: $t not found (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi)" >&2; exit 2; }
+done
+gen=""
+command -v ninja >/dev/null 2>&1 && gen="-G Ninja"
+if ! cmake -S "$top" -B "$bdir" $gen -DCMAKE_TOOLCHAIN_FILE="$top/cmake/cortex-m4.cmake" \
+     -DGS_BUILD_HOST=OFF -DCMAKE_BUILD_TYPE=MinSizeRel >"$bdir.configure.log" 2>&1; then
+  cat "$bdir.configure.log" >&2; echo "firmware_size: configure failed" >&2; exit 2
+fi
+rm -f "$bdir.configure.log"
+if ! cmake --build "$bdir" >"$bdir/build.log" 2>&1; then
+  cat "$bdir/build.log" >&2; echo "firmware_size: build failed" >&2; exit 2
+fi
+elf=$bdir/gravscale_fw.elf
+map=$bdir/gravscale_fw.map
+lib=$bdir/libgravscale_core.a
+fail=0
+
+# 1. nothing from the heap, printf or strtod families is linked (nor sbrk, which a heap needs)
+bad=$(arm-none-eabi-nm "$elf" | awk '$2 ~ /^[TtWw]$/ {print $3}' | grep -E \
+  '^_?(malloc|calloc|realloc|free|_malloc_r|_free_r|_calloc_r|_realloc_r|sbrk|_sbrk|_sbrk_r|printf|fprintf|sprintf|snprintf|vprintf|vfprintf|vsprintf|vsnprintf|_printf_r|_vfprintf_r|_svfprintf_r|_vfiprintf_r|puts|putchar|strtod|strtof|strtold|_strtod_r|atof|sscanf|_svfscanf_r)$' || true)
+if [ -n "$bad" ]; then
+  echo "FAIL forbidden symbols linked:" $bad; fail=1
+else
+  echo "ok   no malloc/free/printf/strtod family symbol in the firmware"
+fi
+# ... and the core library references none either (whatever firmware links it)
+undef=$(arm-none-eabi-nm -u "$lib" | awk '$1 == "U" {print $2}' | sort -u)
+ubad=$(echo "$undef" | grep -E \
+  '^(malloc|calloc|realloc|free|printf|fprintf|sprintf|snprintf|vsnprintf|puts|strtod|strtof|atof|sscanf)$' || true)
+if [ -n "$ubad" ]; then
+  echo "FAIL the core library references:" $ubad; fail=1
+else
+  echo "ok   the core library references no heap/stdio/strtod; it needs: $(echo "$undef" | grep -v -E '^(__aeabi_|gs_)' | tr '\n' ' ')"
+  echo "     + $(echo "$undef" | grep -c '^__aeabi_') soft-float/64-bit helpers from libgcc: $(echo "$undef" | grep '^__aeabi_' | tr '\n' ' ')"
+fi
+
+# 2. sizes
+echo "--- arm-none-eabi-size $elf"
+arm-none-eabi-size "$elf"
+set -- $(arm-none-eabi-size "$elf" | awk 'NR == 2 {print $1, $2, $3}')
+text=$1; data=$2; bss=$3
+# linked bytes per input file, from the map (after --gc-sections)
+echo "--- linked code+rodata by origin (bytes)"
+awk '
+  function hex(s,   i, c, v) { v = 0; s = tolower(substr(s, 3)); for (i = 1; i <= length(s); i++) { c = index("0123456789abcdef", substr(s, i, 1)) - 1; v = v * 16 + c } return v }
+  /^Linker script and memory map/ {on = 1; next}
+  !on {next}
+  /^ \.(text|rodata)/ {
+    if (NF >= 4) { sz = $3; f = $4 } else { getline; sz = $2; f = $3 }
+    if (f == "" || sz !~ /^0x/) next
+    n = hex(sz)
+    if (f ~ /libgravscale_core\.a\(/) { sub(/.*\(/, "", f); sub(/\.c\.obj\)/, "", f); k = "core " f }
+    else if (f ~ /libm\.a/) k = "libm (double/float maths)"
+    else if (f ~ /libgcc\.a/) k = "libgcc (soft double, 64-bit division)"
+    else if (f ~ /libc_nano\.a/) k = "libc nano (memset/memcpy)"
+    else if (f ~ /fw_main/) k = "fw_main (app, start-up)"
+    else k = "other " f
+    tot[k] += n
+  }
+  END { for (k in tot) printf "%7d  %s\n", tot[k], k }' "$map" | sort -k2 > "$bdir/origin.txt" 2>/dev/null || true
+if [ -s "$bdir/origin.txt" ]; then
+  cat "$bdir/origin.txt"
+  core=$(awk '$2 == "core" {s += $1} END {print s + 0}' "$bdir/origin.txt")
+else
+  core=unknown
+fi
+code=$((text + data))
+echo "--- budgets"
+echo "code (flash: text + data)      : $code B (core $core B); target <= $CODE_TARGET B"
+if [ "$code" -gt "$CODE_TARGET" ]; then
+  if [ "${GS_FW_STRICT:-0}" = 1 ]; then echo "FAIL code over the target"; fail=1; else echo "OVER code target (reported; GS_FW_STRICT=1 enforces it)"; fi
+else
+  echo "ok   code within target"
+fi
+# RAM: the ring, the rest of the core's state, and what the app adds
+sym_size() { arm-none-eabi-nm -S -t d "$elf" | awk -v s="$1" '$4 == s {print $2 + 0}'; }
+storage=$(sym_size g_storage); pipe=$(sym_size g_pipe); cfg=$(sym_size g_cfg); line=$(sym_size g_line)
+ring=$((RING_SAMPLES * 16))
+state=$((pipe + storage - ring))
+echo "ram  ring ($RING_SAMPLES x 16 B)       : $ring B"
+echo "ram  state (gs_pipeline $pipe B + inlier bits $((storage - ring)) B): $state B; budget <= $STATE_BUDGET B"
+echo "ram  app (line buffer $line B, config copy $cfg B), .data+.bss total $((data + bss)) B incl. a 4096 B stack reserve"
+if [ "$state" -gt "$STATE_BUDGET" ] || [ "$storage" -lt "$ring" ]; then
+  echo "FAIL state over budget"; fail=1
+else
+  echo "ok   state within budget"
+fi
+# deepest stack frames of the core (-fstack-usage), for the stack reserve
+su=$(find "$bdir/CMakeFiles/gravscale_core.dir" -name '*.su' 2>/dev/null | head -1)
+if [ -n "$su" ]; then
+  echo "--- largest core stack frames (bytes)"
+  find "$bdir/CMakeFiles/gravscale_core.dir" -name '*.su' -exec cat {} + | sort -t'	' -k2 -n -r | head -5 |
+    awk -F'\t' '{n = split($1, a, ":"); printf "%7d  %s\n", $2, a[n]}'
+fi
+if [ $fail -ne 0 ]; then echo "firmware_size: FAILED"; exit 1; fi
+echo "firmware_size: ok"
