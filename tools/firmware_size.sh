@@ -7,6 +7,7 @@
 # Exit 0: built, no forbidden symbol, state within budget. 1: a check failed.
 # 2: no cross compiler or the build failed. The code target (24 KB) is reported, and
 # enforced only with GS_FW_STRICT=1 (docs/firmware.md says where the bytes are).
+# GS_FW_REAL=double builds the fits in double instead of float (for comparison).
 set -eu
 top=$(cd "$(dirname "$0")/.." && pwd)
 bdir=${1:-$top/build-m4}
@@ -22,7 +23,7 @@ done
 gen=""
 command -v ninja >/dev/null 2>&1 && gen="-G Ninja"
 if ! cmake -S "$top" -B "$bdir" $gen -DCMAKE_TOOLCHAIN_FILE="$top/cmake/cortex-m4.cmake" \
-     -DGS_BUILD_HOST=OFF -DCMAKE_BUILD_TYPE=MinSizeRel >"$bdir.configure.log" 2>&1; then
+     -DGS_BUILD_HOST=OFF -DGS_REAL=${GS_FW_REAL:-float} -DCMAKE_BUILD_TYPE=MinSizeRel >"$bdir.configure.log" 2>&1; then
   cat "$bdir.configure.log" >&2; echo "firmware_size: configure failed" >&2; exit 2
 fi
 rm -f "$bdir.configure.log"

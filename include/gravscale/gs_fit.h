@@ -8,11 +8,11 @@
 #include "gs_ring.h"
 
 typedef struct {
-    double t0_s, tscale_s;
-    double r[6];          /* upper triangle of R, row-major: r00 r01 r02 r11 r12 r22 */
-    double zx[3], zy[3];  /* Q^T * sqrt(w) * x and y */
-    double ssr_x, ssr_y;  /* weighted residual sum of squares */
-    double sum_w;
+    double t0_s, tscale_s;  /* double: t0 is an absolute time */
+    gs_real r[6];          /* upper triangle of R, row-major: r00 r01 r02 r11 r12 r22 */
+    gs_real zx[3], zy[3];  /* Q^T * sqrt(w) * x and y */
+    gs_real ssr_x, ssr_y;  /* weighted residual sum of squares */
+    gs_real sum_w;
     uint32_t n;           /* samples with w > 0 */
 } gs_fit;
 

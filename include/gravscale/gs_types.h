@@ -8,6 +8,22 @@
 
 #define GS_VERSION "0.1.0"
 
+/* The arithmetic of the fits: double on hosts, float on single-precision FPUs
+ * (the cortex-m4 build sets -DGS_REAL=float; docs/firmware.md has the numbers).
+ * Absolute times stay double everywhere: only centred, scaled differences of
+ * them enter gs_real arithmetic. */
+#ifndef GS_REAL
+#define GS_REAL double
+#endif
+typedef GS_REAL gs_real;
+#define GS_R(x) ((gs_real)(x))
+/* sqrt and fabs of a gs_real without <tgmath.h> */
+#define GS_SQRT(x) (sizeof(gs_real) < sizeof(double) ? (gs_real)sqrtf((float)(x)) : (gs_real)sqrt((double)(x)))
+#define GS_FABS(x) ((x) < GS_R(0.0) ? -(x) : (x))
+/* cos and sin of a double argument, in float where gs_real is float (no double trig linked) */
+#define GS_COS(x) (sizeof(gs_real) < sizeof(double) ? (double)cosf((float)(x)) : cos((double)(x)))
+#define GS_SIN(x) (sizeof(gs_real) < sizeof(double) ? (double)sinf((float)(x)) : sin((double)(x)))
+
 typedef enum {
     GS_OK = 0,
     GS_EINVAL,   /* bad argument or value */

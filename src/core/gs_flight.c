@@ -199,15 +199,15 @@ static double fit_sigma(const gs_flight *f, const gs_fit_result *r)
 }
 
 /* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) */
-static double pred_var_factor(const gs_fit *fit, double t_s)
+static gs_real pred_var_factor(const gs_fit *fit, double t_s)
 {
-    double tau = (t_s - fit->t0_s) / fit->tscale_s;
-    double x0 = 1.0, x1 = tau, x2 = tau * tau;
-    const double *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
-    if (r[0] == 0.0 || r[3] == 0.0 || r[5] == 0.0) return INFINITY;
-    double z0 = x0 / r[0];
-    double z1 = (x1 - r[1] * z0) / r[3];
-    double z2 = (x2 - r[2] * z0 - r[4] * z1) / r[5];
+    gs_real tau = (gs_real)((t_s - fit->t0_s) / fit->tscale_s);  /* absolute times meet in double */
+    gs_real x0 = GS_R(1.0), x1 = tau, x2 = tau * tau;
+    const gs_real *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
+    if (r[0] == GS_R(0.0) || r[3] == GS_R(0.0) || r[5] == GS_R(0.0)) return (gs_real)INFINITY;
+    gs_real z0 = x0 / r[0];
+    gs_real z1 = (x1 - r[1] * z0) / r[3];
+    gs_real z2 = (x2 - r[2] * z0 - r[4] * z1) / r[5];
     return z0 * z0 + z1 * z1 + z2 * z2;
 }
 
@@ -218,19 +218,21 @@ static double pred_var_factor(const gs_fit *fit, double t_s)
 static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
                         const gs_sample_full *s, double *z)
 {
-    double dt = s->t_s - r->t0_s;
-    double px = r->x0_px + r->vx_px_s * dt + 0.5 * r->ax_px_s2 * dt * dt;
-    double py = r->y0_px + r->vy_px_s * dt + 0.5 * r->ay_px_s2 * dt * dt;
-    double ex = (double)s->x_px - px, ey = (double)s->y_px - py;
-    double gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
-    if (!isfinite(gx) || !isfinite(gy)) { gx = -f->up_x; gy = -f->up_y; }
-    double up = -(ex * gx + ey * gy);
-    double perp = ex * (-gy) + ey * gx;
-    double sig = fit_sigma(f, r);
-    double vf = pred_var_factor(fit, s->t_s);
-    double tot = sig * sqrt(1.0 + (isfinite(vf) ? vf : 1e6));
-    *z = up / tot;
-    return !(fabs(perp) > GROSS_OUTLIER * tot || up < -GROSS_OUTLIER * tot);
+    /* per sample and per boundary candidate: gs_real; only the time difference is double */
+    gs_real dt = (gs_real)(s->t_s - r->t0_s);
+    gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
+    gs_real px = (gs_real)r->x0_px + (gs_real)r->vx_px_s * dt + GS_R(0.5) * ax * dt * dt;
+    gs_real py = (gs_real)r->y0_px + (gs_real)r->vy_px_s * dt + GS_R(0.5) * ay * dt * dt;
+    gs_real ex = (gs_real)s->x_px - px, ey = (gs_real)s->y_px - py;
+    gs_real gx = ax / a, gy = ay / a;
+    if (!isfinite(gx) || !isfinite(gy)) { gx = (gs_real)-f->up_x; gy = (gs_real)-f->up_y; }
+    gs_real up = -(ex * gx + ey * gy);
+    gs_real perp = ex * (-gy) + ey * gx;
+    gs_real sig = (gs_real)fit_sigma(f, r);
+    gs_real vf = pred_var_factor(fit, s->t_s);
+    gs_real tot = sig * GS_SQRT(GS_R(1.0) + (isfinite(vf) ? vf : GS_R(1e6)));
+    *z = (double)(up / tot);
+    return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
 }
 
 /* one-sided CUSUM of z: contact raises it, noise drains it */
@@ -261,7 +263,8 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double si
     double max_ang = f->up_from_flight ? 25.0 : (f->up_n > 0 ? 40.0 : 60.0);
     max_ang += 2.0 * rel_se * 180.0 / GS_PI;
     if (max_ang > 80.0) max_ang = 80.0;
-    if (!(cosang > cos(max_ang * GS_PI / 180.0))) return false;
+    /* a threshold: single precision is plenty where double is emulated */
+    if (!(cosang > GS_COS(max_ang * GS_PI / 180.0))) return false;
     double a_hi = r->a_px_s2 + 2.0 * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - 2.0 * rel_se * r->a_px_s2;
     if (isfinite(size_px) && size_px > 0.0) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
@@ -382,29 +385,31 @@ static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
 /* ---- boundary refinement with a piecewise model (1D, along up) ------------- */
 
 /* Solve the k x k (k <= 4) symmetric system A c = b by Cholesky; false if not PD. */
-static bool solve_spd(double A[4][4], double b[4], int k, double c[4])
+static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
 {
-    double L[4][4] = {{0}};
+    /* a pivot below this fraction of its diagonal: not positive definite at this precision */
+    const gs_real tiny = sizeof(gs_real) < sizeof(double) ? GS_R(1e-6) : GS_R(1e-12);
+    gs_real L[4][4] = {{0}};
     for (int i = 0; i < k; i++) {
         for (int j = 0; j <= i; j++) {
-            double s = A[i][j];
+            gs_real s = A[i][j];
             for (int m = 0; m < j; m++) s -= L[i][m] * L[j][m];
             if (i == j) {
-                if (!(s > 1e-12 * (A[i][i] > 0 ? A[i][i] : 1.0))) return false;
-                L[i][i] = sqrt(s);
+                if (!(s > tiny * (A[i][i] > 0 ? A[i][i] : GS_R(1.0)))) return false;
+                L[i][i] = GS_SQRT(s);
             } else {
                 L[i][j] = s / L[j][j];
             }
         }
     }
-    double y[4];
+    gs_real y[4];
     for (int i = 0; i < k; i++) {
-        double s = b[i];
+        gs_real s = b[i];
         for (int m = 0; m < i; m++) s -= L[i][m] * y[m];
         y[i] = s / L[i][i];
     }
     for (int i = k - 1; i >= 0; i--) {
-        double s = y[i];
+        gs_real s = y[i];
         for (int m = i + 1; m < k; m++) s -= L[m][i] * c[m];
         c[i] = s / L[i][i];
     }
@@ -419,41 +424,47 @@ static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double
                             double T, int side, double alpha_min_px, double alpha_max_px,
                             const gs_fit_result *r)
 {
-    double A[4][4] = {{0}}, b[4] = {0}, yy = 0.0;
+    /* called per boundary candidate and sample: gs_real. In float, u is taken about
+     * the first sample's (the SSR below is yy - c.b, which cancels), in double as is */
+    gs_real A[4][4] = {{0}}, b[4] = {0}, yy = GS_R(0.0);
+    gs_real u_c = GS_R(0.0);
+    bool have_c = sizeof(gs_real) == sizeof(double);
+    gs_real ts2 = (gs_real)(ts * ts);
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         double z;
         if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
-        double w = (double)s->w;
-        double tau = (s->t_s - tc) / ts;
-        double d = side < 0 ? (T - s->t_s) : (s->t_s - T);
-        double h = d > 0.0 ? 0.5 * d * d / (ts * ts) : 0.0;
-        double x[4] = {1.0, tau, tau * tau, h};
-        double u = u_of(f, s);
+        gs_real w = (gs_real)s->w;
+        gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
+        gs_real d = (gs_real)(side < 0 ? (T - s->t_s) : (s->t_s - T));
+        gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
+        gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
+        if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
+        gs_real u = (gs_real)u_of(f, s) - u_c;
         for (int k = 0; k < 4; k++) {
             b[k] += w * x[k] * u;
             for (int m = 0; m < 4; m++) A[k][m] += w * x[k] * x[m];
         }
         yy += w * u * u;
     }
-    double c[4];
-    double c3_min = alpha_min_px * ts * ts, c3_max = alpha_max_px * ts * ts;  /* alpha in tau units */
-    bool solved = A[3][3] > 0.0 && solve_spd(A, b, 4, c);
+    gs_real c[4];
+    gs_real c3_min = (gs_real)(alpha_min_px * ts * ts), c3_max = (gs_real)(alpha_max_px * ts * ts);  /* alpha in tau units */
+    bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
     if (solved && c[3] >= c3_min && c[3] <= c3_max) {
-        double ssr = yy;
+        gs_real ssr = yy;
         for (int k = 0; k < 4; k++) ssr -= c[k] * b[k];
-        return ssr > 0.0 ? ssr : 0.0;
+        return ssr > GS_R(0.0) ? (double)ssr : 0.0;
     }
     /* alpha at a bound: fit the parabola to u - alpha h */
-    double al = A[3][3] > 0.0 ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : 0.0;
-    double b3[4];
+    gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
+    gs_real b3[4];
     for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
-    double yy3 = yy - 2.0 * al * b[3] + al * al * A[3][3];
+    gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
     if (!solve_spd(A, b3, 3, c)) return INFINITY;
-    double ssr = yy3;
+    gs_real ssr = yy3;
     for (int k = 0; k < 3; k++) ssr -= c[k] * b3[k];
-    return ssr > 0.0 ? ssr : 0.0;
+    return ssr > GS_R(0.0) ? (double)ssr : 0.0;
 }
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples. */
