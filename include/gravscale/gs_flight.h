@@ -31,7 +31,7 @@ typedef struct {
     bool trace;
     bool rigid;                /* object size is measured in every frame (ball), not while standing */
     uint32_t track;            /* reported in every event (several objects: one pipeline each) */
-    double g_m_s2;
+    double g_m_s2;             /* double here and below: per-frame or per-flight state (gs_flight.c says why) */
 
     gs_flight_state state;
     uint64_t next;             /* next ring index to examine */

@@ -1,5 +1,6 @@
 /* gs_config.c - "[section]" / "key = value" text parsed in place (no heap, no
- * copies), each key routed to its section's handler; the [core] handler. */
+ * copies), each key routed to its section's handler; the [core] handler.
+ * double: parsed once at start-up. */
 #include "gravscale/gs_config.h"
 #include "gravscale/gs_num.h"
 

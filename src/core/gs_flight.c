@@ -6,7 +6,18 @@
  * as a one-sided deviation against gravity); the left side is grown from the
  * ring history when the flight closes. Take-off and landing are then refined
  * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
- * the boundary) and the final robust 2D fit uses only samples in free flight. */
+ * the boundary) and the final robust 2D fit uses only samples in free flight.
+ *
+ * float vs double (the Cortex-M4's FPU is single precision; double is emulated):
+ * what runs per sample inside the fits and per boundary candidate is gs_real
+ * (float there: test_sample, pred_var_factor, piecewise_ssr, solve_spd, and all
+ * of gs_fit.c). What stays double, and why:
+ *  - absolute times (t_s, T0, T1, last_t_s, peak_t, blk_t0, still_since, ...):
+ *    a stream runs for days and float seconds lose milliseconds after hours;
+ *  - the per-frame state machine (u, noise, levels, thresholds): a few dozen
+ *    operations a frame, kept double so hosts keep their exact results;
+ *  - closing a flight (event fields, SE, apex, jump height): once per flight,
+ *    and the event's public fields are double. */
 #include "gravscale/gs_flight.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
-/* gs_pipeline.c - keypoints -> COM sample -> ring -> flights -> aggregate -> events. */
+/* gs_pipeline.c - keypoints -> COM sample -> ring -> flights -> aggregate -> events.
+ * double: the caller's timestamps (absolute; the ring keeps 32-bit microseconds). */
 #include "gravscale/gs_pipeline.h"
 
 #include <math.h>
