@@ -73,7 +73,7 @@ awk '
     else if (f ~ /libm\.a/) k = "libm (double/float maths)"
     else if (f ~ /libgcc\.a/) k = "libgcc (soft double, 64-bit division)"
     else if (f ~ /libc_nano\.a/) k = "libc nano (memset/memcpy)"
-    else if (f ~ /fw_main/) k = "fw_main (app, start-up)"
+    else if (f ~ /fw_main|fw_scenario/) k = "fw_main + fw_scenario (app, start-up)"
     else k = "other " f
     tot[k] += n
   }
@@ -94,12 +94,12 @@ else
 fi
 # RAM: the ring, the rest of the core's state, and what the app adds
 sym_size() { arm-none-eabi-nm -S -t d "$elf" | awk -v s="$1" '$4 == s {print $2 + 0}'; }
-storage=$(sym_size g_storage); pipe=$(sym_size g_pipe); cfg=$(sym_size g_cfg); line=$(sym_size g_line)
+storage=$(sym_size g_storage); pipe=$(sym_size g_pipe); cfg=$(sym_size g_cfg); line=$(( $(sym_size g_line) + $(sym_size g_last) ))
 ring=$((RING_SAMPLES * 16))
 state=$((pipe + storage - ring))
 echo "ram  ring ($RING_SAMPLES x 16 B)       : $ring B"
 echo "ram  state (gs_pipeline $pipe B + inlier bits $((storage - ring)) B): $state B; budget <= $STATE_BUDGET B"
-echo "ram  app (line buffer $line B, config copy $cfg B), .data+.bss total $((data + bss)) B incl. a 4096 B stack reserve"
+echo "ram  app (line buffers $line B, config copy $cfg B), .data+.bss total $((data + bss)) B incl. a 4096 B stack reserve"
 if [ "$state" -gt "$STATE_BUDGET" ] || [ "$storage" -lt "$ring" ]; then
   echo "FAIL state over budget"; fail=1
 else
@@ -111,6 +111,43 @@ if [ -n "$su" ]; then
   echo "--- largest core stack frames (bytes)"
   find "$bdir/CMakeFiles/gravscale_core.dir" -name '*.su' -exec cat {} + | sort -t'	' -k2 -n -r | head -5 |
     awk -F'\t' '{n = split($1, a, ":"); printf "%7d  %s\n", $2, a[n]}'
+fi
+# 3. run it: QEMU's Cortex-M4 board (netduinoplus2, STM32F405) with semihosting prints the
+# lines; they must equal the same workload built for the host with the same GS_REAL,
+# byte for byte (IEEE single precision on both), and match the double build's events
+if command -v qemu-system-arm >/dev/null 2>&1; then
+  real=${GS_FW_REAL:-float}
+  qout=$bdir/fw_qemu.out
+  rm -f "$qout"
+  if timeout 300 qemu-system-arm -M netduinoplus2 -nographic -monitor none -serial none \
+       -chardev file,id=semi,path="$qout" -semihosting-config enable=on,target=native,chardev=semi \
+       -kernel "$bdir/gravscale_fw_qemu.elf" >"$bdir/fw_qemu.err" 2>&1 && [ -s "$qout" ]; then
+    hcc=${CC_HOST:-cc}
+    for r in "$real" double; do
+      "$hcc" -std=c11 -O2 -DGS_REAL=$r -I"$top/include" -I"$top/tools/fw" "$top"/src/core/*.c \
+        "$top/tools/fw/fw_scenario.c" "$top/tools/fw/fw_host.c" -lm -o "$bdir/fw_host_$r" &&
+        "$bdir/fw_host_$r" >"$bdir/fw_host_$r.out" || { echo "FAIL host twin ($r) did not build or run"; fail=1; }
+    done
+    n=$(grep -c '"event":"jump"' "$qout" || true)
+    if cmp -s "$qout" "$bdir/fw_host_$real.out"; then
+      echo "ok   on QEMU's Cortex-M4: $n jump events, every line identical to the host build with GS_REAL=$real"
+    else
+      echo "FAIL the Cortex-M4 lines differ from the host's (GS_REAL=$real):"; diff "$qout" "$bdir/fw_host_$real.out" | head -5; fail=1
+    fi
+    # against double: the same events and decisions, heights within 1 mm
+    if awk -F'"height_m":' 'FNR == NR {a[FNR] = $0; next}
+         { if (!(FNR in a)) exit 1
+           split(a[FNR], x, "\"height_m\":"); split($0, y, "\"height_m\":")
+           if ((a[FNR] ~ /"accepted":true/) != ($0 ~ /"accepted":true/)) exit 1
+           if (length(x) > 1 && length(y) > 1) { d = (x[2] + 0) - (y[2] + 0); if (d < 0) d = -d; if (d > m) m = d }
+           n++ }
+         END { if (n != NR - length(a)) exit 1; printf "ok   vs the double build: same events and decisions, heights within %.4f m\n", m; if (m > 0.001) exit 1 }' \
+         "$qout" "$bdir/fw_host_double.out"; then :; else echo "FAIL float vs double beyond 1 mm or other events"; fail=1; fi
+  else
+    echo "FAIL the firmware did not run to its end under QEMU:"; head -5 "$bdir/fw_qemu.err"; fail=1
+  fi
+else
+  echo "skip qemu-system-arm not installed: the firmware was linked, not run (apt-get install --no-install-recommends qemu-system-arm)"
 fi
 if [ $fail -ne 0 ]; then echo "firmware_size: FAILED"; exit 1; fi
 echo "firmware_size: ok"

@@ -1,98 +1,55 @@
-/* fw_main.c - firmware link test of the core on a Cortex-M4F: the pipeline on
- * static memory (a 512-sample ring), a profile parsed from flash, a synthetic
- * bouncing ball (or, when g_use_pose is set, a hopping COCO-17 skeleton) pushed
- * frame by frame, and every event formatted into a line buffer as a serial sink
- * would send it. No heap, no stdio: tools/firmware_size.sh checks the symbols
- * and reports the sizes. Runs on hardware or a simulator; built by the
- * cortex-m4 preset. */
-#include <math.h>
+/* fw_main.c - firmware link test of the core on a Cortex-M4F: start-up code and
+ * the workload of fw_scenario.c (the ball, or the skeleton when g_use_pose is
+ * set, so both input paths are linked). Lines go to a buffer as a serial sink
+ * would send them; built with FW_SEMIHOST they are also written to the
+ * debugger's console (QEMU -semihosting) and the program exits with the
+ * scenario's status. tools/firmware_size.sh checks the symbols and sizes. */
+#include <stdint.h>
 #include <string.h>
 
-#include "gravscale/gravscale.h"
-
-#define FW_RING_CAP 512u
-#define FW_FPS 60.0
-
-/* ring + inlier bits, as gs_pipeline_storage_bytes computes for FW_RING_CAP */
-#define FW_STORAGE_BYTES (FW_RING_CAP * sizeof(gs_sample) + (FW_RING_CAP + 31u) / 32u * 4u)
-static uint64_t g_storage[(FW_STORAGE_BYTES + 7u) / 8u];  /* 8-byte aligned */
-static gs_pipeline g_pipe;
-static gs_core_config g_cfg;
+#include "fw_scenario.h"
 
 /* what a serial sink would send: the last line and a count */
-static char g_line[GS_EMIT_MAX];
+static char g_last[700];
 volatile uint32_t g_line_len;
 volatile uint32_t g_n_lines;
 volatile uint32_t g_status;
-/* set by a debugger (or the test harness) to drive the keypoint path */
+/* set by a debugger to drive the keypoint path */
 volatile uint32_t g_use_pose;
 
-static const char k_profile[] =
-    "[core]\n"
-    "fit = irls\n"
-    "ring_capacity = 512\n"
-    "size_min_m = 0.02\n"
-    "size_max_m = 2.5\n";
-
-static gs_status core_section(void *ctx, const char *key, size_t key_len, const char *value,
-                              size_t value_len, char *msg, size_t cap)
+#ifdef FW_SEMIHOST
+/* ARM semihosting: r0 = operation, r1 = argument, BKPT 0xAB */
+static uint32_t semihost(uint32_t op, const void *arg)
 {
-    return gs_core_config_set(ctx, key, key_len, value, value_len, msg, cap);
+    register uint32_t r0 __asm("r0") = op;
+    register const void *r1 __asm("r1") = arg;
+    __asm volatile("bkpt 0xAB" : "+r"(r0) : "r"(r1) : "memory");
+    return r0;
 }
+#endif
 
-static void on_event(void *ctx, const gs_event *ev)
+static void on_line(const char *line, size_t len)
 {
-    (void)ctx;
-    size_t n = gs_emit(g_cfg.format, ev, g_line, sizeof g_line);
-    if (n > 0) {
-        g_line_len = (uint32_t)n;
-        g_n_lines++;
-    }
-}
-
-/* height of a ball bouncing with 0.45 s flights, in metres at time t */
-static float bounce_m(float t)
-{
-    const float g = 9.81f, flight = 0.45f, v0 = 0.5f * g * flight;
-    float x = fmodf(t, flight + 0.15f);
-    if (x > flight) return 0.0f;  /* on the floor */
-    return v0 * x - 0.5f * g * x * x;
-}
-
-static void push_pose(double t, float y_off_px)
-{
-    /* a standing skeleton 500 px tall, lifted by y_off_px */
-    static const float k_y[17] = {60, 52, 52, 56, 56, 110, 110, 190, 190, 260, 260, 290, 290, 400, 400, 530, 530};
-    static const float k_x[17] = {0, -6, 6, -14, 14, -40, 40, -48, 48, -50, 50, -22, 22, -24, 24, -24, 24};
-    gs_kp kp[17];
-    for (int i = 0; i < 17; i++) {
-        kp[i].x_px = 640.0f + k_x[i];
-        kp[i].y_px = 100.0f + k_y[i] - y_off_px;
-        kp[i].c = 0.9f;
-    }
-    g_status |= (uint32_t)gs_pipeline_push_keypoints(&g_pipe, t, kp);
+    size_t n = len < sizeof g_last - 1u ? len : sizeof g_last - 1u;
+    memcpy(g_last, line, n);
+    g_last[n] = '\0';
+    g_line_len = (uint32_t)n;
+    g_n_lines++;
+#ifdef FW_SEMIHOST
+    semihost(0x04u, g_last);  /* SYS_WRITE0 */
+#endif
 }
 
 int main(void)
 {
-    gs_cfg_error err;
-    const gs_cfg_section sec = {"core", core_section, &g_cfg};
-    gs_core_config_default(&g_cfg);
-    g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
-    bool pose = g_use_pose != 0u;
-    g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, pose ? GS_LAYOUT_COCO17 : GS_LAYOUT_POINT,
-                                           g_storage, sizeof g_storage, on_event, NULL);
-    const float q_m_per_px = 0.002f;
-    for (uint32_t i = 0; i < 6u * (uint32_t)FW_FPS; i++) {
-        double t = 1000.0 + (double)i / FW_FPS;
-        float h = bounce_m((float)i / (float)FW_FPS);
-        if (pose) {
-            push_pose(t, h / q_m_per_px);
-        } else {
-            g_status |= (uint32_t)gs_pipeline_push_point(&g_pipe, t, 320.0f, 400.0f - h / q_m_per_px, 1.0f, 34.35f);
-        }
-    }
-    g_status |= (uint32_t)gs_pipeline_flush(&g_pipe);
+    g_status = fw_scenario_run(g_use_pose != 0u, on_line);
+#ifdef FW_SEMIHOST
+    /* both paths when run under a debugger: the ball, then the skeleton */
+    semihost(0x04u, "--- pose\n");
+    g_status |= fw_scenario_run(true, on_line);
+    /* SYS_EXIT with ADP_Stopped_ApplicationExit: QEMU exits */
+    semihost(0x18u, (const void *)(uintptr_t)0x20026u);
+#endif
     for (;;) {
     }
 }
