@@ -99,7 +99,7 @@ ring=$((RING_SAMPLES * 16))
 state=$((pipe + storage - ring))
 echo "ram  ring ($RING_SAMPLES x 16 B)       : $ring B"
 echo "ram  state (gs_pipeline $pipe B + inlier bits $((storage - ring)) B): $state B; budget <= $STATE_BUDGET B"
-echo "ram  app (line buffers $line B, config copy $cfg B), .data+.bss total $((data + bss)) B incl. a 4096 B stack reserve"
+echo "ram  app (line buffers $line B, config copy $cfg B), .data+.bss total $((data + bss)) B incl. the stack reserve"
 if [ "$state" -gt "$STATE_BUDGET" ] || [ "$storage" -lt "$ring" ]; then
   echo "FAIL state over budget"; fail=1
 else
@@ -122,6 +122,9 @@ if command -v qemu-system-arm >/dev/null 2>&1; then
   if timeout 300 qemu-system-arm -M netduinoplus2 -nographic -monitor none -serial none \
        -chardev file,id=semi,path="$qout" -semihosting-config enable=on,target=native,chardev=semi \
        -kernel "$bdir/gravscale_fw_qemu.elf" >"$bdir/fw_qemu.err" 2>&1 && [ -s "$qout" ]; then
+    # lines starting with '#' are the firmware's own report (stack high-water mark)
+    stack=$(awk '/^# stack bytes/ {print $4}' "$qout")
+    grep -v '^#' "$qout" >"$qout.lines" && mv "$qout.lines" "$qout"
     hcc=${CC_HOST:-cc}
     for r in "$real" double; do
       "$hcc" -std=c11 -O2 -DGS_REAL=$r -I"$top/include" -I"$top/tools/fw" "$top"/src/core/*.c \
@@ -131,6 +134,12 @@ if command -v qemu-system-arm >/dev/null 2>&1; then
     n=$(grep -c '"event":"jump"' "$qout" || true)
     if cmp -s "$qout" "$bdir/fw_host_$real.out"; then
       echo "ok   on QEMU's Cortex-M4: $n jump events, every line identical to the host build with GS_REAL=$real"
+      reserve=$(awk '/_stack_size =/ {gsub(/[^0-9]/, "", $3); print $3 * 1024; exit}' "$top/tools/fw/m4.ld")
+      if [ -n "$stack" ] && [ "$stack" -le "$reserve" ]; then
+        echo "ok   stack high-water mark on the target: $stack B (reserve $reserve B)"
+      else
+        echo "FAIL stack high-water mark '$stack' B beyond the reserve $reserve B"; fail=1
+      fi
     else
       echo "FAIL the Cortex-M4 lines differ from the host's (GS_REAL=$real):"; diff "$qout" "$bdir/fw_host_$real.out" | head -5; fail=1
     fi

@@ -17,6 +17,8 @@ volatile uint32_t g_status;
 /* set by a debugger to drive the keypoint path */
 volatile uint32_t g_use_pose;
 
+extern uint32_t _sstack_reserve, _estack;
+
 #ifdef FW_SEMIHOST
 /* ARM semihosting: r0 = operation, r1 = argument, BKPT 0xAB */
 static uint32_t semihost(uint32_t op, const void *arg)
@@ -47,6 +49,20 @@ int main(void)
     /* both paths when run under a debugger: the ball, then the skeleton */
     semihost(0x04u, "--- pose\n");
     g_status |= fw_scenario_run(true, on_line);
+    {
+        /* stack high-water mark: the reset handler painted the reserve */
+        const uint32_t *p = &_sstack_reserve;
+        while (p < &_estack && *p == 0xA5A5A5A5u) p++;
+        uint32_t used = (uint32_t)((uintptr_t)&_estack - (uintptr_t)p);
+        char msg[32] = "# stack bytes ";
+        char *d = msg + 14, tmp[12];
+        int n = 0;
+        do { tmp[n++] = (char)('0' + used % 10u); used /= 10u; } while (used > 0u);
+        while (n > 0) *d++ = tmp[--n];
+        *d++ = '\n';
+        *d = '\0';
+        semihost(0x04u, msg);
+    }
     /* SYS_EXIT with ADP_Stopped_ApplicationExit: QEMU exits */
     semihost(0x18u, (const void *)(uintptr_t)0x20026u);
 #endif
@@ -56,7 +72,7 @@ int main(void)
 
 /* ---- start-up: vectors, .data/.bss, the FPU ----------------------------------- */
 
-extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
+extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss;
 void Reset_Handler(void);
 void Default_Handler(void);
 
@@ -71,6 +87,10 @@ void Reset_Handler(void)
     uint32_t *src = &_sidata, *dst = &_sdata;
     while (dst < &_edata) *dst++ = *src++;
     for (dst = &_sbss; dst < &_ebss;) *dst++ = 0u;
+#ifdef FW_SEMIHOST
+    /* paint the stack reserve below the current frame (main reports the high-water mark) */
+    for (dst = &_sstack_reserve; (uintptr_t)dst < (uintptr_t)__builtin_frame_address(0) - 64u;) *dst++ = 0xA5A5A5A5u;
+#endif
     /* CP10/CP11 full access: hard-float code faults without it */
     *(volatile uint32_t *)0xE000ED88u |= 0xFu << 20;
     __asm volatile("dsb\n isb" ::: "memory");
