@@ -69,7 +69,17 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     const gs_cfg_section sec = {"core", core_section, &g_cfg};
     g_sink = line;
     gs_core_config_default(&g_cfg);
+#ifndef FW_NO_PROFILE
     g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
+#else
+    /* a compiled-in configuration: no text parser linked (measures its cost) */
+    (void)sec;
+    (void)err;
+    (void)k_profile;
+    g_cfg.size_min_m = 0.02f;
+    g_cfg.size_max_m = 2.5f;
+    g_status = 0;
+#endif
     g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, pose ? GS_LAYOUT_COCO17 : GS_LAYOUT_POINT,
                                            g_storage, sizeof g_storage, on_event, NULL);
     const float q_m_per_px = 0.002f;
