@@ -123,7 +123,10 @@ typedef struct {
 
 static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(double) + 8];
 
-static void run(const sim_track *s, const cam *c, capture *cap, double t_end)
+static void run_from(const sim_track *s, const cam *c, capture *cap, double t_begin, double t_end);
+static void run(const sim_track *s, const cam *c, capture *cap, double t_end) { run_from(s, c, cap, 0.0, t_end); }
+
+static void run_from(const sim_track *s, const cam *c, capture *cap, double t_begin, double t_end)
 {
     gs_core_config cfg;
     gs_core_config_default(&cfg);
@@ -134,7 +137,7 @@ static void run(const sim_track *s, const cam *c, capture *cap, double t_end)
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, cap));
     double ca = cos(c->roll_deg * PI / 180.0), sa = sin(c->roll_deg * PI / 180.0);
     double size_px = c->size_m / c->q_m_per_px;
-    for (long i = 0;; i++) {
+    for (long i = (long)ceil(t_begin * c->fps);; i++) {
         double t = (i + c->phase) / c->fps;
         if (t > t_end) break;
         bool air;
@@ -331,6 +334,103 @@ static void test_ring_smaller_than_a_flight(void)
         if (cap.jumps[e].accepted) TEST_ASSERT_DOUBLE_WITHIN(0.01 * 3270.0, 3270.0, cap.jumps[e].a_px_s2);
 }
 
+/* A daemon runs for hours: the ring keeps 32-bit microseconds that wrap every
+ * 2^32 us = 71.6 min. Jumps around three wrap points (one flight straddles each)
+ * are found and measured exactly as the same jumps near the start. */
+static void set_jumps(sim_track *s, const double *take_s, int n)
+{
+    make_track(s, n, 0.0, 1.0, 2.0, 2.0);
+    for (int k = 0; k < n; k++) {
+        sim_jump *j = &s->jumps[k];
+        j->t_takeoff = take_s[k];
+        j->t_start = j->t_takeoff - s->cm_dur - j->v0 / s->a_prop;
+        j->t_land = j->t_takeoff + 2.0 * j->v0 / s->g;
+    }
+}
+
+static void test_hours_across_time_wraps(void)
+{
+    cam c = {30.0, 0.003, 0.0, 0.0, 0.20, 0.0, 0.37};
+    const double base = c.phase / c.fps;     /* the first sample: the ring's time base */
+    const double wrap_s = 4294.967296;       /* 2^32 us */
+    const double rel[3] = {-2.7, -0.2, 2.3}; /* the middle flight spans the wrap */
+    double take[9];
+    for (int lap = 0; lap < 3; lap++)
+        for (int k = 0; k < 3; k++) take[3 * lap + k] = base + wrap_s * (lap + 1) + rel[k];
+    sim_track s;
+    set_jumps(&s, take, 9);
+    static capture cap_ref, cap;
+    /* the same stream from t = 0 (wraps inside the flights) and from 2000 s (its
+     * wraps fall 2000 s away from every jump): the same frames, the same events */
+    run(&s, &c, &cap, 3.0 * wrap_s + 5.0);
+    run_from(&s, &c, &cap_ref, 2000.0, 3.0 * wrap_s + 5.0);
+    int map_ref[MAX_JUMPS], map[MAX_JUMPS];
+    TEST_ASSERT_EQUAL_INT(9, match(&s, &cap_ref, map_ref));
+    TEST_ASSERT_EQUAL_INT(9, match(&s, &cap, map));
+    TEST_ASSERT_EQUAL_INT(9, cap.n_jumps);
+    for (int k = 0; k < 9; k++) {
+        const gs_ev_jump *j = &cap.jumps[map[k]], *r = &cap_ref.jumps[map_ref[k]];
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6 * r->a_px_s2, r->a_px_s2, j->a_px_s2);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, r->height_m, j->height_m);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, r->t_takeoff_s, j->t_takeoff_s);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, r->t_land_s, j->t_land_s);
+        TEST_ASSERT_EQUAL_UINT32(r->n_samples, j->n_samples);
+        TEST_ASSERT_DOUBLE_WITHIN(0.003 * 0.20, 0.20, j->height_m);
+    }
+}
+
+/* A pause longer than the ring's time span (35.8 min) in the middle of a
+ * flight: the flight closes on what was seen, as on a pause within the span
+ * (10 s, also a gap that ends the flight), and later jumps are found as then. */
+static void run_with_pause(double pause_s, double cut_after_s, capture *cap)
+{
+    sim_track s;
+    make_track(&s, 3, 1.5, 2.5, 2.0, 2.0);
+    gs_core_config cfg;
+    gs_core_config_default(&cfg);
+    cfg.size_min_m = 0.01f;
+    static gs_pipeline p;
+    memset(cap, 0, sizeof *cap);
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, cap));
+    double cut = s.jumps[1].t_takeoff + cut_after_s;
+    bool first_after = true;
+    for (long i = 0; i < 30 * 10; i++) {
+        double tu = i / 30.0;
+        bool air;
+        double u = track_u(&s, tu, &air);
+        double t = tu > cut ? tu + pause_s : tu;  /* the rest of the stream comes after the pause */
+        cap->now = t;
+        TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, t, 500.0f, (float)(600.0 - u / 0.003), 1.0f, 66.7f));
+        if (tu > cut && first_after) {
+            first_after = false;
+            /* beyond the span only the newest sample is left in the ring */
+            TEST_ASSERT_EQUAL_UINT32(pause_s > 2147.5 ? 1u : 31u, gs_ring_count(&p.ring) > 31u ? 31u : gs_ring_count(&p.ring));
+        }
+    }
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
+}
+
+static void test_pause_beyond_time_span(void)
+{
+    static const double cuts[] = {0.05, 0.3, 0.45};  /* rising, past the apex, near landing */
+    for (size_t k = 0; k < sizeof cuts / sizeof cuts[0]; k++) {
+        static capture near, far;
+        run_with_pause(10.0, cuts[k], &near);
+        run_with_pause(3000.0, cuts[k], &far);
+        TEST_ASSERT_TRUE(near.n_jumps >= 2);  /* the first and the last jump at least */
+        TEST_ASSERT_EQUAL_INT(near.n_jumps, far.n_jumps);
+        for (int e = 0; e < near.n_jumps; e++) {
+            const gs_ev_jump *a = &near.jumps[e], *b = &far.jumps[e];
+            double sh = a->t_takeoff_s > 5.0 ? 2990.0 : 0.0;
+            TEST_ASSERT_EQUAL_INT(a->accepted, b->accepted);
+            TEST_ASSERT_EQUAL_UINT32(a->n_samples, b->n_samples);
+            TEST_ASSERT_EQUAL_UINT32(a->warnings, b->warnings);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-6 * fabs(a->a_px_s2) + 1e-9, a->a_px_s2, b->a_px_s2);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-4, a->t_takeoff_s + sh, b->t_takeoff_s);
+        }
+    }
+}
+
 static void test_bad_calls(void)
 {
     gs_core_config cfg;
@@ -357,6 +457,8 @@ int main(void)
     RUN_TEST(test_no_flight);
     RUN_TEST(test_time_gaps);
     RUN_TEST(test_ring_smaller_than_a_flight);
+    RUN_TEST(test_hours_across_time_wraps);
+    RUN_TEST(test_pause_beyond_time_span);
     RUN_TEST(test_bad_calls);
     return UNITY_END();
 }

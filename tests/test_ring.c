@@ -25,9 +25,9 @@ void setUp(void)
 void tearDown(void) {}
 
 /* A sample that encodes its absolute index so a wrong slot is detected. */
-static gs_sample mk(uint64_t i)
+static gs_sample_full mk(uint64_t i)
 {
-    gs_sample s;
+    gs_sample_full s;
     s.t_s = (double)i;
     s.x_px = (float)(i % 65536u);
     s.y_px = (float)((i * 7u) % 65536u);
@@ -36,7 +36,6 @@ static gs_sample mk(uint64_t i)
     s.up_x = 0.0f;
     s.up_y = -1.0f;
     s.upright = 1.0f;
-    s.reserved = 0.0f;
     return s;
 }
 
@@ -57,10 +56,11 @@ static void assert_window(uint64_t oldest, uint64_t head)
     TEST_ASSERT_TRUE(gs_ring_oldest(&g_r) == oldest);
     TEST_ASSERT_EQUAL_UINT32((uint32_t)(head - oldest), gs_ring_count(&g_r));
     for (uint64_t i = oldest; i < head; i++) {
-        const gs_sample *s = gs_ring_at(&g_r, i);
-        TEST_ASSERT_NOT_NULL(s);
-        TEST_ASSERT_TRUE(s->t_s == (double)i);
-        TEST_ASSERT_EQUAL_FLOAT((float)(i % 65536u), s->x_px);
+        gs_sample_full s;
+        TEST_ASSERT_NOT_NULL(gs_ring_at(&g_r, i));
+        TEST_ASSERT_TRUE(gs_ring_get(&g_r, i, &s));
+        TEST_ASSERT_TRUE(s.t_s == (double)i);
+        TEST_ASSERT_EQUAL_FLOAT((float)(i % 65536u), s.x_px);
     }
     TEST_ASSERT_NULL(gs_ring_at(&g_r, head));
     TEST_ASSERT_NULL(gs_ring_at(&g_r, head + 1u));
@@ -105,7 +105,7 @@ static void test_empty_ring(void)
 static void test_fill_and_overwrite_oldest(void)
 {
     for (uint64_t i = 0; i < 3u * CAP + 5u; i++) {
-        gs_sample s = mk(i);
+        gs_sample_full s = mk(i);
         gs_ring_push(&g_r, &s);
         uint64_t head = i + 1u;
         uint64_t oldest = head > CAP ? head - CAP : 0u;
@@ -121,11 +121,11 @@ static void run_across(uint64_t start)
     g_r.head = start;
     /* Refill every slot so the held window contains only real samples. */
     for (uint64_t i = start; i < start + CAP; i++) {
-        gs_sample s = mk(i);
+        gs_sample_full s = mk(i);
         gs_ring_push(&g_r, &s);
     }
     for (uint64_t i = start + CAP; i < start + 3u * CAP + 3u; i++) {
-        gs_sample s = mk(i);
+        gs_sample_full s = mk(i);
         gs_ring_push(&g_r, &s);
         assert_window(i + 1u - CAP, i + 1u);
         assert_canaries();
@@ -150,7 +150,7 @@ static void test_wrap_near_uint64_large_index(void)
 static void test_at_returns_null_for_evicted_and_future(void)
 {
     for (uint64_t i = 0; i < CAP + 4u; i++) {
-        gs_sample s = mk(i);
+        gs_sample_full s = mk(i);
         gs_ring_push(&g_r, &s);
     }
     TEST_ASSERT_NULL(gs_ring_at(&g_r, 0));
@@ -159,16 +159,200 @@ static void test_at_returns_null_for_evicted_and_future(void)
     TEST_ASSERT_NOT_NULL(gs_ring_at(&g_r, CAP + 3u));
     TEST_ASSERT_NULL(gs_ring_at(&g_r, CAP + 4u));
     /* The evicted index 3 and the held index 3+CAP share a slot: only the held one resolves. */
-    TEST_ASSERT_TRUE(gs_ring_at(&g_r, CAP + 3u)->t_s == (double)(CAP + 3u));
+    TEST_ASSERT_TRUE(gs_ring_sample_t_s(&g_r, gs_ring_at(&g_r, CAP + 3u)) == (double)(CAP + 3u));
 }
 
 static void test_push_copies_sample(void)
 {
-    gs_sample s = mk(42);
+    gs_sample_full s = mk(42);
     gs_ring_push(&g_r, &s);
     s.t_s = -1.0;  /* the caller's copy changes, the ring's does not */
-    TEST_ASSERT_TRUE(gs_ring_at(&g_r, 0)->t_s == 42.0);
-    TEST_ASSERT_TRUE(isnan(gs_ring_at(&g_r, 0)->size_px));
+    gs_sample_full g;
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, 0, &g));
+    TEST_ASSERT_TRUE(g.t_s == 42.0);
+    TEST_ASSERT_TRUE(isnan(g.size_px));
+    TEST_ASSERT_FALSE(gs_ring_get(&g_r, 1, &g));
+}
+
+/* ---- the packed 16-byte form ------------------------------------------------------------ */
+
+static gs_sample_full roundtrip(float size_px, float w, float upright)
+{
+    gs_sample_full s = mk(gs_ring_head(&g_r)), out;
+    s.t_s = (double)gs_ring_head(&g_r);
+    s.size_px = size_px;
+    s.w = w;
+    s.upright = upright;
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, gs_ring_head(&g_r) - 1u, &out));
+    TEST_ASSERT_TRUE(out.x_px == s.x_px && out.y_px == s.y_px);  /* x, y stay floats */
+    return out;
+}
+
+static void test_sample_layout_and_precision(void)
+{
+    TEST_ASSERT_EQUAL_UINT32(16, (uint32_t)sizeof(gs_sample));
+    /* size: 1/16 px steps below 2048 px, 1/4 px to 10240 px, beyond or invalid unknown */
+    static const float sizes[] = {0.0f, 0.03f, 7.19f, 12.3f, 549.86f, 1234.5678f, 2047.96f, 2047.99f,
+                                  2048.0f, 2100.1f, 3000.3f, 8191.0f, 10239.0f};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        float tol = sizes[k] < 2047.97f ? 1.0f / 32.0f : 1.0f / 8.0f;
+        gs_sample_full o = roundtrip(sizes[k], 1.0f, 1.0f);
+        TEST_ASSERT_FLOAT_WITHIN(tol + 1e-4f, sizes[k], o.size_px);
+    }
+    TEST_ASSERT_TRUE(isnan(roundtrip(NAN, 1.0f, 1.0f).size_px));
+    TEST_ASSERT_TRUE(isnan(roundtrip(-2.0f, 1.0f, 1.0f).size_px));
+    TEST_ASSERT_TRUE(isnan(roundtrip(10300.0f, 1.0f, 1.0f).size_px));
+    TEST_ASSERT_TRUE(isnan(roundtrip(INFINITY, 1.0f, 1.0f).size_px));
+    /* w in 1/255: 0 stays 0 (unusable), a positive w never becomes 0, 1 stays exactly 1 */
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, roundtrip(1.0f, 0.0f, 1.0f).w);
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, roundtrip(1.0f, NAN, 1.0f).w);
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, roundtrip(1.0f, -0.5f, 1.0f).w);
+    TEST_ASSERT_TRUE(roundtrip(1.0f, 1e-6f, 1.0f).w > 0.0f);
+    TEST_ASSERT_TRUE(roundtrip(1.0f, 1.0f, 1.0f).w == 1.0f);
+    TEST_ASSERT_TRUE(roundtrip(1.0f, 3.0f, 1.0f).w == 1.0f);
+    for (int k = 2; k < 1000; k++) {  /* from 1/510 up; below it rounds up to 1/255 */
+        float w = (float)k / 1000.0f;
+        TEST_ASSERT_FLOAT_WITHIN(0.5f / 255.0f + 1e-6f, w, roundtrip(1.0f, w, 1.0f).w);
+    }
+    /* upright in 1/250, floored: the tenths the flight compares with decide as before */
+    TEST_ASSERT_TRUE(isnan(roundtrip(1.0f, 1.0f, NAN).upright));
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, roundtrip(1.0f, 1.0f, -1.0f).upright);
+    TEST_ASSERT_EQUAL_FLOAT(1.0f, roundtrip(1.0f, 1.0f, 2.0f).upright);
+    for (int k = 0; k <= 1000; k++) {
+        float u = (float)k / 1000.0f;
+        float o = roundtrip(1.0f, 1.0f, u).upright;
+        TEST_ASSERT_TRUE(o <= u && u - o < 1.0f / 250.0f + 1e-6f);
+        TEST_ASSERT_EQUAL_INT(u >= 0.5f, o >= 0.5f);
+        TEST_ASSERT_EQUAL_INT(u >= 0.7f, o >= 0.7f);
+    }
+}
+
+/* The body axis is kept for the newest sample only (it is consumed then). */
+static void test_body_axis_newest_only(void)
+{
+    gs_sample_full s = mk(0), o;
+    s.up_x = 0.6f;
+    s.up_y = -0.8f;
+    gs_ring_push(&g_r, &s);
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, 0, &o));
+    TEST_ASSERT_EQUAL_FLOAT(0.6f, o.up_x);
+    TEST_ASSERT_EQUAL_FLOAT(-0.8f, o.up_y);
+    s = mk(1);
+    gs_ring_push(&g_r, &s);
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, 0, &o));
+    TEST_ASSERT_TRUE(isnan(o.up_x) && isnan(o.up_y));
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, 1, &o));
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, o.up_x);
+    TEST_ASSERT_EQUAL_FLOAT(-1.0f, o.up_y);
+}
+
+/* ---- time: microseconds modulo 2^32 around the newest sample ------------------------------ */
+
+static void push_t(double t)
+{
+    gs_sample_full s = mk(gs_ring_head(&g_r));
+    s.t_s = t;
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
+}
+
+/* Every held sample reads back its own time, in whole microseconds since base. */
+static void assert_times(double base, const double *t, uint64_t n_pushed)
+{
+    for (uint64_t i = gs_ring_oldest(&g_r); i < gs_ring_head(&g_r); i++) {
+        gs_sample_full o;
+        TEST_ASSERT_TRUE(gs_ring_get(&g_r, i, &o));
+        double want = base + (double)(int64_t)((t[i % n_pushed] - base) * 1e6 + 0.5) / 1e6;
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9 * (1.0 + fabs(want)), want, o.t_s);
+    }
+}
+
+/* A daemon runs for hours: the 32-bit microsecond field wraps every 71.6 min. Start
+ * just before the wrap (as ring tests of RTOS kernels do) and cross it three times. */
+static void test_time_wraps_every_71_minutes(void)
+{
+    static double t[CAP];
+    const double base = 1.0e5 + 0.123456;  /* a boot clock far from zero */
+    const double wrap_s = 4294.967296;
+    push_t(base);
+    t[0] = base;
+    /* minute steps up to just before the first wrap: the ring spans 16 min */
+    uint64_t n = 1;
+    for (double u = 60.0; u < wrap_s - 0.5; u += 60.0, n++) {
+        t[n % CAP] = base + u;
+        push_t(base + u);
+    }
+    for (int lap = 0; lap < 3; lap++) {
+        double w0 = base + wrap_s * (lap + 1);
+        /* 1 ms frames (plus a jittered fraction) across the wrap point */
+        for (int k = -40; k < 40; k++, n++) {
+            double tk = w0 + k * 1e-3 + (k % 3) * 1.7e-7;
+            t[n % CAP] = tk;
+            push_t(tk);
+            assert_times(base, t, CAP);
+        }
+        /* differences inside the ring are exact through the wrap */
+        gs_sample_full a, b;
+        TEST_ASSERT_TRUE(gs_ring_get(&g_r, n - 1u, &b));
+        TEST_ASSERT_TRUE(gs_ring_get(&g_r, n - CAP, &a));
+        TEST_ASSERT_DOUBLE_WITHIN(2e-6, (double)(CAP - 1u) * 1e-3, b.t_s - a.t_s);
+        /* minutes to the next lap */
+        for (double u = 60.0; u < wrap_s - 60.0; u += 60.0, n++) {
+            t[n % CAP] = w0 + u;
+            push_t(w0 + u);
+        }
+        assert_times(base, t, CAP);
+    }
+    TEST_ASSERT_TRUE(gs_ring_count(&g_r) == CAP);
+}
+
+/* Samples 2^31 us (35.8 min) older than the newest leave the ring, as if overwritten. */
+static void test_time_span_evicts(void)
+{
+    push_t(0.0);
+    push_t(1.0);
+    push_t(1200.0);          /* 20 min */
+    TEST_ASSERT_EQUAL_UINT32(3, gs_ring_count(&g_r));
+    push_t(2147.0);          /* the first two are 2146 s old: still inside */
+    TEST_ASSERT_EQUAL_UINT32(4, gs_ring_count(&g_r));
+    push_t(2149.0);          /* now 0.0 and 1.0 are past 2147.48 s */
+    TEST_ASSERT_EQUAL_UINT64(2, gs_ring_oldest(&g_r));
+    TEST_ASSERT_NULL(gs_ring_at(&g_r, 1));
+    gs_sample_full o;
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, 2, &o));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1200.0, o.t_s);
+    push_t(2149.0 + 40.0 * 60.0);  /* a 40 min pause: nothing before it can be told apart */
+    TEST_ASSERT_EQUAL_UINT32(1, gs_ring_count(&g_r));
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, gs_ring_head(&g_r) - 1u, &o));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 4549.0, o.t_s);
+    push_t(4 * 3600.0);           /* hours later, across a wrap */
+    push_t(4 * 3600.0 + 0.5);
+    TEST_ASSERT_EQUAL_UINT32(2, gs_ring_count(&g_r));
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, gs_ring_oldest(&g_r), &o));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 14400.0, o.t_s);
+}
+
+static void test_time_order_and_bad_times(void)
+{
+    gs_sample_full s = mk(0);
+    s.t_s = 5.0;
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));       /* equal: stored */
+    s.t_s = 5.0 - 2e-6;
+    TEST_ASSERT_EQUAL_INT(GS_EORDER, gs_ring_push(&g_r, &s));
+    s.t_s = 5.0 - 4e-7;                                           /* the same microsecond */
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
+    s.t_s = NAN;
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, &s));
+    s.t_s = INFINITY;
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, &s));
+    s.t_s = 1e13;                                                 /* 2^62 us from the base and beyond */
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, &s));
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(NULL, &s));
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, NULL));
+    TEST_ASSERT_EQUAL_UINT32(3, gs_ring_count(&g_r));
+    TEST_ASSERT_TRUE(gs_ring_time_us(&g_r, 6.5) == 1500000);
+    TEST_ASSERT_TRUE(gs_ring_time_us(&g_r, NAN) == INT64_MIN);
 }
 
 int main(void)
@@ -181,5 +365,10 @@ int main(void)
     RUN_TEST(test_wrap_near_uint64_large_index);
     RUN_TEST(test_at_returns_null_for_evicted_and_future);
     RUN_TEST(test_push_copies_sample);
+    RUN_TEST(test_sample_layout_and_precision);
+    RUN_TEST(test_body_axis_newest_only);
+    RUN_TEST(test_time_wraps_every_71_minutes);
+    RUN_TEST(test_time_span_evicts);
+    RUN_TEST(test_time_order_and_bad_times);
     return UNITY_END();
 }

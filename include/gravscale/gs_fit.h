@@ -8,11 +8,11 @@
 #include "gs_ring.h"
 
 typedef struct {
-    double t0_s, tscale_s;
-    double r[6];          /* upper triangle of R, row-major: r00 r01 r02 r11 r12 r22 */
-    double zx[3], zy[3];  /* Q^T * sqrt(w) * x and y */
-    double ssr_x, ssr_y;  /* weighted residual sum of squares */
-    double sum_w;
+    double t0_s, tscale_s;  /* double: t0 is an absolute time */
+    gs_real r[6];          /* upper triangle of R, row-major: r00 r01 r02 r11 r12 r22 */
+    gs_real zx[3], zy[3];  /* Q^T * sqrt(w) * x and y */
+    gs_real ssr_x, ssr_y;  /* weighted residual sum of squares */
+    gs_real sum_w;
     uint32_t n;           /* samples with w > 0 */
 } gs_fit;
 
@@ -47,13 +47,17 @@ const char *gs_fit_method_name(gs_fit_method m);
 bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out);
 
 /* Robust fit of the ring samples [first, first+count) using each sample's w as
- * prior weight. scratch_w: caller memory for `count` floats; on return holds
- * each sample's final weight (0 = rejected as outlier). min_scale_px: floor for
- * the residual scale (keeps perfect data from rejecting everything).
+ * prior weight. keep: caller memory for `count` bits ((count + 31) / 32 words);
+ * on return bit i is set when sample first+i kept a positive final weight
+ * (clear = rejected as outlier or unusable). min_scale_px: floor for the
+ * residual scale (keeps perfect data from rejecting everything). No other
+ * memory: the medians are selected without a buffer.
  * Returns GS_EINVAL when a sample is missing from the ring or < 3 remain
  * (with 3 the SE is NaN, as in gs_fit_solve). */
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count,
                         gs_fit_method method, float min_scale_px,
-                        float *scratch_w, gs_fit_result *out);
+                        uint32_t *keep, gs_fit_result *out);
+/* Bit i of a keep set from gs_fit_robust (false for a NULL set). */
+bool gs_fit_kept(const uint32_t *keep, uint32_t i);
 
 #endif

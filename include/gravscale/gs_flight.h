@@ -25,13 +25,13 @@ typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 typedef struct {
     const gs_core_config *cfg;
     const gs_ring *ring;
-    float *scratch_w;          /* ring->capacity floats */
+    uint32_t *keep;            /* ring->capacity bits: the robust fits' inlier flags */
     gs_event_fn on_event;
     void *ctx;
     bool trace;
     bool rigid;                /* object size is measured in every frame (ball), not while standing */
     uint32_t track;            /* reported in every event (several objects: one pipeline each) */
-    double g_m_s2;
+    double g_m_s2;             /* double here and below: per-frame or per-flight state (gs_flight.c says why) */
 
     gs_flight_state state;
     uint64_t next;             /* next ring index to examine */
@@ -79,10 +79,13 @@ typedef struct {
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
-                         float *scratch_w, bool rigid, gs_event_fn on_event, void *ctx);
+                         uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx);
 /* Examine every sample pushed to the ring since the last call. Emits GS_EV_JUMP
  * events through on_event (and trace events when f->trace). */
 void gs_flight_update(gs_flight *f);
+/* The stream pauses longer than the ring's time span (GS_RING_SPAN_US): close
+ * an open candidate now, while the ring still holds its samples. */
+void gs_flight_break(gs_flight *f);
 /* End of stream: close any open candidate. */
 void gs_flight_finish(gs_flight *f);
 /* The standing size this sample added (NaN when the sample at t_s was no still, upright frame). */

@@ -8,6 +8,22 @@
 
 #define GS_VERSION "0.1.0"
 
+/* The arithmetic of the fits: double on hosts, float on single-precision FPUs
+ * (the cortex-m4 build sets -DGS_REAL=float; docs/firmware.md has the numbers).
+ * Absolute times stay double everywhere: only centred, scaled differences of
+ * them enter gs_real arithmetic. */
+#ifndef GS_REAL
+#define GS_REAL double
+#endif
+typedef GS_REAL gs_real;
+#define GS_R(x) ((gs_real)(x))
+/* sqrt and fabs of a gs_real without <tgmath.h> */
+#define GS_SQRT(x) (sizeof(gs_real) < sizeof(double) ? (gs_real)sqrtf((float)(x)) : (gs_real)sqrt((double)(x)))
+#define GS_FABS(x) ((x) < GS_R(0.0) ? -(x) : (x))
+/* cos and sin of a double argument, in float where gs_real is float (no double trig linked) */
+#define GS_COS(x) (sizeof(gs_real) < sizeof(double) ? (double)cosf((float)(x)) : cos((double)(x)))
+#define GS_SIN(x) (sizeof(gs_real) < sizeof(double) ? (double)sinf((float)(x)) : sin((double)(x)))
+
 typedef enum {
     GS_OK = 0,
     GS_EINVAL,   /* bad argument or value */
@@ -34,9 +50,10 @@ typedef enum {
     GS_LAYOUT_BLAZEPOSE33 /* BlazePose-33 order (heels 29/30, foot index 31/32) */
 } gs_layout;
 
-/* A per-frame sample as kept in the ring: the COM (or object centre) and the
- * object's pixel size this frame (stature in px when upright, ball diameter);
- * NaN where unknown. */
+/* A per-frame sample at full precision, as a source delivers it and as
+ * gs_ring_get gives it back: the COM (or object centre) and the object's
+ * pixel size this frame (stature in px when upright, ball diameter); NaN where
+ * unknown. */
 typedef struct {
     double t_s;      /* source timestamp, seconds */
     float x_px;      /* COM x */
@@ -46,7 +63,25 @@ typedef struct {
     float up_x;      /* unit vector of the body axis feet->head in the image, NaN unknown */
     float up_y;
     float upright;   /* 0..1 how upright/straight the body stands (1 for rigid objects), NaN unknown */
-    float reserved;
+} gs_sample_full;
+
+/* The same sample as stored in the ring: 16 bytes (512 samples = 8 KB). Read it
+ * through gs_ring_get / the gs_ring_sample_* accessors (gs_ring.h), which know
+ * the ring's time base. The body axis (up_x, up_y) is consumed when the frame
+ * is examined, so only the newest frame's is kept (in the ring, not here). */
+typedef struct {
+    uint32_t t_us;       /* microseconds since the ring's time base, modulo 2^32 */
+    float x_px;          /* COM x, NaN unknown */
+    float y_px;          /* COM y (down), NaN unknown */
+    uint16_t size_q;     /* size: 1/16 px below 2048 px, then 1/4 px up to 10240 px; 0xFFFF unknown */
+    uint8_t w_q;         /* w in 1/255 (a positive w never rounds to 0) */
+    uint8_t upright_q;   /* upright in 1/250, floored (thresholds at tenths stay exact); 255 unknown */
 } gs_sample;
+
+#ifdef __cplusplus
+static_assert(sizeof(gs_sample) == 16, "the ring sample must stay 16 bytes");
+#else
+_Static_assert(sizeof(gs_sample) == 16, "the ring sample must stay 16 bytes");
+#endif
 
 #endif

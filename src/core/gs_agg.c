@@ -1,7 +1,8 @@
 /* gs_agg.c - robust running aggregate of per-flight sizes: the median of the
  * newest GS_AGG_MAX accepted flights and a 95 % interval that stays honest
  * from one flight to many. See docs/anthropometry.md ("Aggregate") for the
- * derivation and the Monte Carlo check in tests/test_agg.c. */
+ * derivation and the Monte Carlo check in tests/test_agg.c.
+ * double: runs once per flight on at most GS_AGG_MAX values (no float needed on an M4). */
 #include <math.h>
 
 #include "gravscale/gs_agg.h"

@@ -1,5 +1,6 @@
 /* gs_config.c - "[section]" / "key = value" text parsed in place (no heap, no
- * copies), each key routed to its section's handler; the [core] handler. */
+ * copies), each key routed to its section's handler; the [core] handler.
+ * double: parsed once at start-up. */
 #include "gravscale/gs_config.h"
 #include "gravscale/gs_num.h"
 
@@ -430,7 +431,8 @@ double gs_gravity_m_s2(double latitude_deg, double altitude_m)
 {
     /* WGS-84 normal gravity on the ellipsoid (Somigliana), then the free-air gradient */
     const double pi = 3.14159265358979323846;
-    double s = sin(latitude_deg * (pi / 180.0));
+    /* float where double is emulated: g to 1e-7 is 100x finer than any site needs */
+    double s = GS_SIN(latitude_deg * (pi / 180.0));
     double s2 = s * s;
     double g0 = 9.7803253359 * (1.0 + 0.00193185265241 * s2) / sqrt(1.0 - 0.00669437999013 * s2);
     return g0 - 3.086e-6 * altitude_m;

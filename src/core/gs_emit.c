@@ -1,5 +1,6 @@
 /* gs_emit.c - events as JSON Lines or NMEA 0183-style sentences in a caller
- * buffer; all or nothing, never past cap. Field layout: docs/protocol.md. */
+ * buffer; all or nothing, never past cap. Field layout: docs/protocol.md.
+ * double: event fields are double (times of day-long streams); one line per event. */
 #include "gravscale/gs_emit.h"
 #include "gravscale/gs_num.h"
 

@@ -3,15 +3,17 @@
 #include "gravscale/gs_fit.h"
 
 #include <math.h>
+#include <string.h>
+#include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
-#define GS_FIT_SINGULAR_REL 1e-9
+#define GS_FIT_SINGULAR_REL (sizeof(gs_real) < sizeof(double) ? GS_R(1e-5) : GS_R(1e-9))
 
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
-#define GS_FIT_TUKEY_C 4.685
+#define GS_FIT_TUKEY_C GS_R(4.685)
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
-#define GS_FIT_MAD_K 1.4826
+#define GS_FIT_MAD_K GS_R(1.4826)
 /* Bounded work for the robust starts: at most this many sample triples. */
 #define GS_FIT_TRIPLES 60u  /* all-inlier triple among 60 fails with p < 1e-6 at 40 % gross outliers */
 /* IRLS stops after this many reweightings even if the weights still move. */
@@ -20,9 +22,9 @@
 #define GS_FIT_SEED_IRLS 0x9E3779B9u
 #define GS_FIT_SEED_RANSAC 0x2545F491u
 /* Internal floor on the residual scale so that a zero scale cannot divide by 0. */
-#define GS_FIT_TINY_SCALE_PX 1e-6
+#define GS_FIT_TINY_SCALE_PX GS_R(1e-6)
 
-static const double rad_to_deg = 57.29577951308232;
+static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
 void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
 {
@@ -34,15 +36,15 @@ void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
     f->tscale_s = (isfinite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0;
     for (k = 0; k < 6; k++) {
-        f->r[k] = 0.0;
+        f->r[k] = GS_R(0.0);
     }
     for (k = 0; k < 3; k++) {
-        f->zx[k] = 0.0;
-        f->zy[k] = 0.0;
+        f->zx[k] = GS_R(0.0);
+        f->zy[k] = GS_R(0.0);
     }
-    f->ssr_x = 0.0;
-    f->ssr_y = 0.0;
-    f->sum_w = 0.0;
+    f->ssr_x = GS_R(0.0);
+    f->ssr_y = GS_R(0.0);
+    f->sum_w = GS_R(0.0);
     f->n = 0;
 }
 
@@ -55,35 +57,36 @@ static int rix(int i, int j)
 
 void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w)
 {
-    double v[3], bx, by, sw, tau;
+    gs_real v[3], bx, by, sw, tau;
     int k, j;
     if (!f || !(w > 0.0) || !isfinite(w) || !isfinite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
         return;
     }
-    sw = sqrt(w);
-    tau = (t_s - f->t0_s) / f->tscale_s;
+    sw = sqrt((gs_real)w);
+    /* the one double step: an absolute time minus the fit's centre */
+    tau = (gs_real)((t_s - f->t0_s) / f->tscale_s);
     v[0] = sw;
     v[1] = sw * tau;
     v[2] = sw * tau * tau;
-    bx = sw * x_px;
-    by = sw * y_px;
+    bx = sw * (gs_real)x_px;
+    by = sw * (gs_real)y_px;
     for (k = 0; k < 3; k++) {
-        double a = f->r[rix(k, k)];
-        double b = v[k];
-        double rho, c, s;
-        if (b == 0.0) {
+        gs_real a = f->r[rix(k, k)];
+        gs_real b = v[k];
+        gs_real rho, c, s;
+        if (b == GS_R(0.0)) {
             continue;
         }
         rho = sqrt(a * a + b * b);
         c = a / rho;
         s = b / rho;
         for (j = k; j < 3; j++) {
-            double rkj = f->r[rix(k, j)];
+            gs_real rkj = f->r[rix(k, j)];
             f->r[rix(k, j)] = c * rkj + s * v[j];
             v[j] = c * v[j] - s * rkj;
         }
         {
-            double zk = f->zx[k];
+            gs_real zk = f->zx[k];
             f->zx[k] = c * zk + s * bx;
             bx = c * bx - s * zk;
             zk = f->zy[k];
@@ -94,7 +97,7 @@ void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w)
     /* What is left of the row after eliminating its basis part is its residual. */
     f->ssr_x += bx * bx;
     f->ssr_y += by * by;
-    f->sum_w += w;
+    f->sum_w += (gs_real)w;
     f->n++;
 }
 
@@ -107,7 +110,7 @@ static void nan_result(gs_fit_result *out)
 }
 
 /* Solve R c = z for the upper-triangular packed R. */
-static void back_sub(const double r[6], const double z[3], double c[3])
+static void back_sub(const gs_real r[6], const gs_real z[3], gs_real c[3])
 {
     c[2] = z[2] / r[5];
     c[1] = (z[1] - r[4] * c[2]) / r[3];
@@ -116,7 +119,7 @@ static void back_sub(const double r[6], const double z[3], double c[3])
 
 gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
 {
-    double cx[3], cy[3], col[3], ts, ts2, ssr;
+    gs_real cx[3], cy[3], col[3], ts, ts2, ssr;
     int k;
     if (!f || !out) {
         return GS_EINVAL;
@@ -132,32 +135,36 @@ gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
     col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
     for (k = 0; k < 3; k++) {
-        double d = fabs(f->r[rix(k, k)]);
-        if (!(col[k] > 0.0) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
+        gs_real d = fabs(f->r[rix(k, k)]);
+        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
             return GS_EINVAL;
         }
     }
     back_sub(f->r, f->zx, cx);
     back_sub(f->r, f->zy, cy);
-    ts = f->tscale_s;
+    ts = (gs_real)f->tscale_s;
     ts2 = ts * ts;
-    out->x0_px = cx[0];
-    out->vx_px_s = cx[1] / ts;
-    out->ax_px_s2 = 2.0 * cx[2] / ts2;
-    out->y0_px = cy[0];
-    out->vy_px_s = cy[1] / ts;
-    out->ay_px_s2 = 2.0 * cy[2] / ts2;
-    out->a_px_s2 = sqrt(out->ax_px_s2 * out->ax_px_s2 + out->ay_px_s2 * out->ay_px_s2);
-    out->g_dir_deg = atan2(out->ax_px_s2, out->ay_px_s2) * rad_to_deg;
+    {
+        /* the results leave as double (the public form), computed in gs_real */
+        gs_real ax = GS_R(2.0) * cx[2] / ts2, ay = GS_R(2.0) * cy[2] / ts2;
+        out->x0_px = (double)cx[0];
+        out->vx_px_s = (double)(cx[1] / ts);
+        out->ax_px_s2 = (double)ax;
+        out->y0_px = (double)cy[0];
+        out->vy_px_s = (double)(cy[1] / ts);
+        out->ay_px_s2 = (double)ay;
+        out->a_px_s2 = (double)sqrt(ax * ax + ay * ay);
+        out->g_dir_deg = (double)(atan2(ax, ay) * rad_to_deg);
+    }
     ssr = f->ssr_x + f->ssr_y;
-    out->rms_px = sqrt(ssr / f->sum_w);
+    out->rms_px = (double)sqrt(ssr / f->sum_w);
     if (f->n > 3) {
         /* Pooled over both axes: 2n residuals, 6 coefficients. */
-        double sigma2 = ssr / (2.0 * ((double)f->n - 3.0));
+        gs_real sigma2 = ssr / (GS_R(2.0) * ((gs_real)f->n - GS_R(3.0)));
         /* Row 2 of R^-1 is (0, 0, 1/r22), so [(R^T R)^-1]_22 = 1/r22^2. */
-        double se_c2 = sqrt(sigma2) / fabs(f->r[5]);
+        gs_real se_c2 = sqrt(sigma2) / fabs(f->r[5]);
         /* var(ax) = var(ay), so the magnitude's variance is the same. */
-        out->a_se_px_s2 = 2.0 * se_c2 / ts2;
+        out->a_se_px_s2 = (double)(GS_R(2.0) * se_c2 / ts2);
     }
     return GS_OK;
 }
@@ -198,7 +205,7 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out)
 
 /* A parabola in tau for both axes: x = c[0] + c[1] tau + c[2] tau^2, y likewise in c[3..5]. */
 typedef struct {
-    double c[6];
+    gs_real c[6];
 } gs_par;
 
 typedef struct {
@@ -206,7 +213,7 @@ typedef struct {
     uint64_t first;
     uint32_t count;
     uint32_t m; /* usable samples in the window */
-    double t0_s, tscale_s;
+    double t0_s, tscale_s;  /* double: absolute time (a stream may run for days) */
 } gs_win;
 
 static uint32_t xorshift32(uint32_t *state)
@@ -225,48 +232,80 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
     return xorshift32(state) % n;
 }
 
-static bool sample_usable(const gs_sample *s)
+/* What a fit reads of a ring sample, unpacked. */
+typedef struct {
+    double t_s;  /* absolute time: only differences from the window's centre leave double */
+    float x_px, y_px, w;
+} gs_fsamp;
+
+/* Window sample i unpacked into *buf; NULL when the ring no longer holds it. */
+static const gs_fsamp *win_at(const gs_ring *ring, uint64_t idx, gs_fsamp *buf)
 {
-    return s && s->w > 0.0f && isfinite(s->w) && isfinite(s->t_s) && isfinite(s->x_px) && isfinite(s->y_px);
+    const gs_sample *s = gs_ring_at(ring, idx);
+    if (!s) {
+        return NULL;
+    }
+    buf->t_s = gs_ring_sample_t_s(ring, s);
+    buf->x_px = s->x_px;
+    buf->y_px = s->y_px;
+    buf->w = gs_sample_w(s);
+    return buf;
 }
 
-static double win_tau(const gs_win *wn, const gs_sample *s)
+static bool sample_usable(const gs_fsamp *s)
 {
-    return (s->t_s - wn->t0_s) / wn->tscale_s;
+    return s && s->w > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
+}
+
+bool gs_fit_kept(const uint32_t *keep, uint32_t i)
+{
+    return keep && ((keep[i >> 5] >> (i & 31u)) & 1u) != 0u;
+}
+
+static void keep_set(uint32_t *keep, uint32_t i, bool on)
+{
+    uint32_t bit = 1u << (i & 31u);
+    keep[i >> 5] = on ? (keep[i >> 5] | bit) : (keep[i >> 5] & ~bit);
+}
+
+static gs_real win_tau(const gs_win *wn, const gs_fsamp *s)
+{
+    /* absolute times meet in double; the centred, unit-length tau fits a float */
+    return (gs_real)((s->t_s - wn->t0_s) / wn->tscale_s);
 }
 
 /* Squared 2D distance of a sample from the parabola, in px^2. */
-static double resid2(const gs_par *p, double tau, const gs_sample *s)
+static gs_real resid2(const gs_par *p, gs_real tau, const gs_fsamp *s)
 {
-    double ex = (double)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
-    double ey = (double)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
+    gs_real ex = (gs_real)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
+    gs_real ey = (gs_real)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
     return ex * ex + ey * ey;
 }
 
 /* 2D distance of a sample from the parabola, in px. */
-static double resid_norm(const gs_par *p, double tau, const gs_sample *s)
+static gs_real resid_norm(const gs_par *p, gs_real tau, const gs_fsamp *s)
 {
     return sqrt(resid2(p, tau, s));
 }
 
 /* The parabola through three samples (Newton divided differences); false when two times coincide. */
-static bool par_through(const gs_win *wn, const gs_sample *a, const gs_sample *b, const gs_sample *c, gs_par *p)
+static bool par_through(const gs_win *wn, const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
 {
-    double ta = win_tau(wn, a), tb = win_tau(wn, b), tc = win_tau(wn, c);
-    double dab = tb - ta, dac = tc - ta, dbc = tc - tb;
+    gs_real ta = win_tau(wn, a), tb = win_tau(wn, b), tc = win_tau(wn, c);
+    gs_real dab = tb - ta, dac = tc - ta, dbc = tc - tb;
     int axis;
-    if (dab == 0.0 || dac == 0.0 || dbc == 0.0) {
+    if (dab == GS_R(0.0) || dac == GS_R(0.0) || dbc == GS_R(0.0)) {
         return false;
     }
     for (axis = 0; axis < 2; axis++) {
-        double va = axis ? a->y_px : a->x_px;
-        double vb = axis ? b->y_px : b->x_px;
-        double vc = axis ? c->y_px : c->x_px;
-        double sab = (vb - va) / dab;
-        double sac = (vc - va) / dac;
-        double c2 = (sac - sab) / dbc;
-        double c1 = sab - c2 * (ta + tb);
-        double c0 = va - ta * (c1 + c2 * ta);
+        gs_real va = axis ? a->y_px : a->x_px;
+        gs_real vb = axis ? b->y_px : b->x_px;
+        gs_real vc = axis ? c->y_px : c->x_px;
+        gs_real sab = (vb - va) / dab;
+        gs_real sac = (vc - va) / dac;
+        gs_real c2 = (sac - sab) / dbc;
+        gs_real c1 = sab - c2 * (ta + tb);
+        gs_real c0 = va - ta * (c1 + c2 * ta);
         p->c[3 * axis + 0] = c0;
         p->c[3 * axis + 1] = c1;
         p->c[3 * axis + 2] = c2;
@@ -277,76 +316,64 @@ static bool par_through(const gs_win *wn, const gs_sample *a, const gs_sample *b
     return true;
 }
 
-/* k-th smallest of v[0..n) (k < n), reordering v in place (Hoare selection). */
-static float select_kth(float *v, uint32_t n, uint32_t k)
+/* Median residual norm of the usable samples, without storage: a radix
+ * selection of the lower median over the bit patterns of the squared residuals
+ * as floats (non-negative floats order like their bits), 4 bits a pass. The
+ * same float is found as by sorting them. */
+static gs_real median_resid(const gs_win *wn, const gs_par *p)
 {
-    int32_t lo = 0, hi = (int32_t)n - 1, kk = (int32_t)k;
-    while (lo < hi) {
-        float pivot = v[lo + (hi - lo) / 2];
-        int32_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] < pivot) {
-                i++;
-            }
-            while (v[j] > pivot) {
-                j--;
-            }
-            if (i <= j) {
-                float tmp = v[i];
-                v[i] = v[j];
-                v[j] = tmp;
-                i++;
-                j--;
+    uint32_t prefix = 0, mask = 0, k, i;
+    int shift;
+    float v;
+    if (wn->m == 0) {
+        return (gs_real)NAN;
+    }
+    k = (wn->m - 1) / 2; /* lower median: exact for odd m, robust enough for even m */
+    for (shift = 28; shift >= 0; shift -= 4) {
+        uint32_t cnt[16] = {0};
+        uint32_t d = 0;
+        for (i = 0; i < wn->count; i++) {
+            gs_fsamp sb;
+            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+            if (sample_usable(s)) {
+                /* squares order like norms: one sqrt for the median instead of one per sample */
+                float r2 = (float)resid2(p, win_tau(wn, s), s);
+                uint32_t key;
+                memcpy(&key, &r2, sizeof key);
+                if ((key & mask) == prefix) {
+                    cnt[(key >> (uint32_t)shift) & 15u]++;
+                }
             }
         }
-        /* Now v[lo..j] <= pivot <= v[i..hi] and anything between equals the pivot. */
-        if (kk <= j) {
-            hi = j;
-        } else if (kk >= i) {
-            lo = i;
-        } else {
-            return v[kk];
+        while (d < 15u && k >= cnt[d]) {
+            k -= cnt[d];
+            d++;
         }
+        prefix |= d << (uint32_t)shift;
+        mask |= 15u << (uint32_t)shift;
     }
-    return v[kk];
-}
-
-/* Median residual norm of the usable samples, using tmp (count floats) as storage. */
-static double median_resid(const gs_win *wn, const gs_par *p, float *tmp)
-{
-    uint32_t i, m = 0;
-    for (i = 0; i < wn->count; i++) {
-        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
-        if (sample_usable(s)) {
-            /* Squares order like norms: one sqrt for the median instead of one per sample. */
-            tmp[m++] = (float)resid2(p, win_tau(wn, s), s);
-        }
-    }
-    if (m == 0) {
-        return (double)NAN;
-    }
-    /* Lower median: exact for odd m, robust enough for even m. */
-    return sqrt((double)select_kth(tmp, m, (m - 1) / 2));
+    memcpy(&v, &prefix, sizeof v);
+    return sqrt((gs_real)v);
 }
 
 /* Tukey biweight of a residual norm r with cut-off cut. */
-static double tukey(double r, double cut)
+static gs_real tukey(gs_real r, gs_real cut)
 {
-    double u;
+    gs_real u;
     if (!(r < cut)) {
-        return 0.0;
+        return GS_R(0.0);
     }
     u = r / cut;
-    u = 1.0 - u * u;
+    u = GS_R(1.0) - u * u;
     return u * u;
 }
 
 /* Final weight of one sample under a model: prior * robust factor, as a float. */
 typedef enum { W_PRIOR, W_TUKEY, W_INLIER } w_mode;
 
-static float sample_weight(const gs_win *wn, const gs_sample *s, const gs_par *p, w_mode mode, double cut)
+static float sample_weight(const gs_win *wn, const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut)
 {
-    double r;
+    gs_real r;
     if (!sample_usable(s)) {
         return 0.0f;
     }
@@ -357,11 +384,11 @@ static float sample_weight(const gs_win *wn, const gs_sample *s, const gs_par *p
     if (mode == W_INLIER) {
         return r <= cut ? s->w : 0.0f;
     }
-    return (float)((double)s->w * tukey(r, cut));
+    return (float)((gs_real)s->w * tukey(r, cut));
 }
 
-/* Weighted LS over the window; writes each sample's weight to w_out, the tau-basis parabola to p. */
-static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, double cut, float *w_out,
+/* Weighted LS over the window; flags each sample with a positive weight in keep, the tau-basis parabola to p. */
+static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, uint32_t *keep,
                             gs_par *p, gs_fit_result *out)
 {
     gs_fit f;
@@ -369,11 +396,12 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     uint32_t i;
     gs_fit_init(&f, wn->t0_s, wn->tscale_s);
     for (i = 0; i < wn->count; i++) {
-        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+        gs_fsamp sb;
+        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
         float w = sample_weight(wn, s, model, mode, cut);
-        w_out[i] = w;
+        keep_set(keep, i, w > 0.0f);
         if (w > 0.0f) {
-            gs_fit_add(&f, s->t_s, s->x_px, s->y_px, (double)w);
+            gs_fit_add(&f, s->t_s, s->x_px, s->y_px, (gs_real)w);
         }
     }
     st = gs_fit_solve(&f, out);
@@ -392,7 +420,8 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
         return k; /* the common case: no scan needed */
     }
     for (i = 0; i < wn->count; i++) {
-        if (sample_usable(gs_ring_at(wn->ring, wn->first + i))) {
+        gs_fsamp sb;
+        if (sample_usable(win_at(wn->ring, wn->first + i, &sb))) {
             if (k == 0) {
                 return i;
             }
@@ -406,25 +435,26 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
  * from each third of the usable samples (well spread in time, so the exact
  * parabola is well conditioned), keep the one with the smallest median
  * residual. Tolerates almost half the samples being gross outliers. */
-static bool lmeds_start(const gs_win *wn, uint32_t m, float *tmp, gs_par *best, double *best_med)
+static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *best_med)
 {
     uint32_t state = GS_FIT_SEED_IRLS;
     uint32_t third = m / 3, k;
     bool found = false;
-    *best_med = (double)INFINITY;
+    *best_med = (gs_real)INFINITY;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
         uint32_t ka = rand_below(&state, third);
         uint32_t kb = third + rand_below(&state, third);
         uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
-        const gs_sample *a = gs_ring_at(wn->ring, wn->first + usable_index(wn, ka));
-        const gs_sample *b = gs_ring_at(wn->ring, wn->first + usable_index(wn, kb));
-        const gs_sample *c = gs_ring_at(wn->ring, wn->first + usable_index(wn, kc));
+        gs_fsamp ab, bb, cb;
+        const gs_fsamp *a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
+        const gs_fsamp *b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
+        const gs_fsamp *c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
         gs_par p;
-        double med;
+        gs_real med;
         if (!par_through(wn, a, b, c, &p)) {
             continue;
         }
-        med = median_resid(wn, &p, tmp);
+        med = median_resid(wn, &p);
         if (med < *best_med) {
             *best_med = med;
             *best = p;
@@ -437,16 +467,16 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, float *tmp, gs_par *best, 
     return found;
 }
 
-static double par_max_shift_px(const gs_par *a, const gs_par *b)
+static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
 {
-    static const double taus[3] = {-0.5, 0.0, 0.5};
-    double worst = 0.0;
+    static const gs_real taus[3] = {-GS_R(0.5), GS_R(0.0), GS_R(0.5)};
+    gs_real worst = GS_R(0.0);
     int k;
     for (k = 0; k < 3; k++) {
-        double t = taus[k];
-        double dx = (a->c[0] - b->c[0]) + t * ((a->c[1] - b->c[1]) + t * (a->c[2] - b->c[2]));
-        double dy = (a->c[3] - b->c[3]) + t * ((a->c[4] - b->c[4]) + t * (a->c[5] - b->c[5]));
-        double d = sqrt(dx * dx + dy * dy);
+        gs_real t = taus[k];
+        gs_real dx = (a->c[0] - b->c[0]) + t * ((a->c[1] - b->c[1]) + t * (a->c[2] - b->c[2]));
+        gs_real dy = (a->c[3] - b->c[3]) + t * ((a->c[4] - b->c[4]) + t * (a->c[5] - b->c[5]));
+        gs_real d = sqrt(dx * dx + dy * dy);
         if (!(d <= worst)) {
             worst = d;
         }
@@ -455,26 +485,26 @@ static double par_max_shift_px(const gs_par *a, const gs_par *b)
 }
 
 /* Tukey biweight IRLS from a start; *fin receives the converged curve. */
-static gs_status irls_from(const gs_win *wn, gs_par cur, double floor_px, float *scratch_w,
+static gs_status irls_from(const gs_win *wn, gs_par cur, gs_real floor_px, uint32_t *keep,
                            gs_fit_result *out, gs_par *fin)
 {
     gs_par next;
-    double med, scale;
+    gs_real med, scale;
     int it;
     gs_status st;
     for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
-        med = median_resid(wn, &cur, scratch_w);
+        med = median_resid(wn, &cur);
         /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
         scale = GS_FIT_MAD_K * med;
         if (!(scale >= floor_px)) {
             scale = floor_px;
         }
-        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, scratch_w, &next, out);
+        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
         if (st != GS_OK) {
             return st;
         }
         /* Settled when the curve moves by far less than the noise. */
-        if (par_max_shift_px(&cur, &next) <= 1e-6 * scale) {
+        if (par_max_shift_px(&cur, &next) <= GS_R(1e-6) * scale) {
             cur = next;
             break;
         }
@@ -486,18 +516,19 @@ static gs_status irls_from(const gs_win *wn, gs_par cur, double floor_px, float 
 
 /* Robust loss of a curve: prior-weighted Tukey rho at the noise floor's cut-off
  * (1 for a rejected sample), comparable between two candidate solutions. */
-static double tukey_loss(const gs_win *wn, const gs_par *p, double floor_px)
+static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
 {
-    double cut = GS_FIT_TUKEY_C * floor_px, loss = 0.0;
+    gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
     for (i = 0; i < wn->count; i++) {
-        const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
-        double u;
+        gs_fsamp sb;
+        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+        gs_real u;
         if (!sample_usable(s)) {
             continue;
         }
         u = sqrt(resid2(p, win_tau(wn, s), s)) / cut;
-        loss += (double)s->w * (u < 1.0 ? 1.0 - (1.0 - u * u) * (1.0 - u * u) * (1.0 - u * u) : 1.0);
+        loss += (gs_real)s->w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
     }
     return loss;
 }
@@ -505,37 +536,37 @@ static double tukey_loss(const gs_win *wn, const gs_par *p, double floor_px)
 /* IRLS from two starts, the least-median-of-squares one (survives many gross
  * outliers) and the plain weighted fit (on clean data a few samples can fit a
  * chance subset better than all of them): the smaller robust loss wins. */
-static gs_status fit_irls(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
 {
     gs_par lms, plain, fin_lms, fin_plain;
-    double med;
-    bool have_lms = lmeds_start(wn, m, scratch_w, &lms, &med);
-    bool have_plain = window_fit(wn, NULL, W_PRIOR, 0.0, scratch_w, &plain, out) == GS_OK;
-    double loss_lms = (double)INFINITY, loss_plain = (double)INFINITY;
+    gs_real med;
+    bool have_lms = lmeds_start(wn, m, &lms, &med);
+    bool have_plain = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &plain, out) == GS_OK;
+    gs_real loss_lms = (gs_real)INFINITY, loss_plain = (gs_real)INFINITY;
     if (!have_lms && !have_plain) {
         return GS_EINVAL;
     }
-    if (have_lms && irls_from(wn, lms, floor_px, scratch_w, out, &fin_lms) == GS_OK) {
+    if (have_lms && irls_from(wn, lms, floor_px, keep, out, &fin_lms) == GS_OK) {
         loss_lms = tukey_loss(wn, &fin_lms, floor_px);
     }
-    if (have_plain && irls_from(wn, plain, floor_px, scratch_w, out, &fin_plain) == GS_OK) {
+    if (have_plain && irls_from(wn, plain, floor_px, keep, out, &fin_plain) == GS_OK) {
         loss_plain = tukey_loss(wn, &fin_plain, floor_px);
     }
     if (!(loss_plain <= loss_lms)) {
-        if (!(loss_lms < (double)INFINITY)) {
+        if (!(loss_lms < (gs_real)INFINITY)) {
             return GS_EINVAL;
         }
-        /* the LMS run won: run it again so scratch_w and out hold its weights */
-        return irls_from(wn, lms, floor_px, scratch_w, out, &fin_lms);
+        /* the LMS run won: run it again so keep and out hold its weights */
+        return irls_from(wn, lms, floor_px, keep, out, &fin_lms);
     }
     return GS_OK;
 }
 
-static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float *scratch_w, gs_fit_result *out)
+static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
 {
     uint32_t state = GS_FIT_SEED_RANSAC;
-    double thr = 3.0 * floor_px;
-    double best_cost = (double)INFINITY;
+    gs_real thr = GS_R(3.0) * floor_px;
+    gs_real best_cost = (gs_real)INFINITY;
     uint32_t best_in = 0, k, i;
     gs_par best;
     bool found = false;
@@ -543,22 +574,24 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float
         uint32_t ka = rand_below(&state, m);
         uint32_t kb = rand_below(&state, m);
         uint32_t kc = rand_below(&state, m);
-        const gs_sample *a, *b, *c;
+        gs_fsamp ab, bb, cb;
+        const gs_fsamp *a, *b, *c;
         gs_par p;
         uint32_t n_in = 0;
-        double cost = 0.0;
+        gs_real cost = GS_R(0.0);
         if (ka == kb || ka == kc || kb == kc) {
             continue;
         }
-        a = gs_ring_at(wn->ring, wn->first + usable_index(wn, ka));
-        b = gs_ring_at(wn->ring, wn->first + usable_index(wn, kb));
-        c = gs_ring_at(wn->ring, wn->first + usable_index(wn, kc));
+        a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
+        b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
+        c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
         if (!par_through(wn, a, b, c, &p)) {
             continue;
         }
         for (i = 0; i < wn->count; i++) {
-            const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
-            double r2;
+            gs_fsamp sb;
+            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+            gs_real r2;
             if (!sample_usable(s)) {
                 continue;
             }
@@ -579,15 +612,15 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, double floor_px, float
     if (!found) {
         return GS_EINVAL;
     }
-    return window_fit(wn, &best, W_INLIER, thr, scratch_w, NULL, out);
+    return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out);
 }
 
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
-                        float min_scale_px, float *scratch_w, gs_fit_result *out)
+                        float min_scale_px, uint32_t *keep, gs_fit_result *out)
 {
     gs_win wn;
-    double t_min = (double)INFINITY, t_max = -(double)INFINITY;
-    double floor_px;
+    double t_min = (double)INFINITY, t_max = -(double)INFINITY;  /* absolute times */
+    gs_real floor_px;
     uint32_t i, m = 0, n_pos = 0;
     gs_status st;
     if (!out) {
@@ -596,14 +629,15 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     out->t0_s = (double)NAN;
     out->n = 0;
     nan_result(out);
-    if (!ring || !scratch_w || count == 0) {
+    if (!ring || !keep || count == 0) {
         return GS_EINVAL;
     }
     for (i = 0; i < count; i++) {
-        scratch_w[i] = 0.0f;
+        keep_set(keep, i, false);
     }
     for (i = 0; i < count; i++) {
-        const gs_sample *s = gs_ring_at(ring, first + i);
+        gs_fsamp sb;
+        const gs_fsamp *s = win_at(ring, first + i, &sb);
         if (!s) {
             /* Overwritten or not yet written: the window is gone. */
             return GS_EINVAL;
@@ -628,17 +662,17 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
     wn.t0_s = t_min + 0.5 * (t_max - t_min);
     wn.tscale_s = t_max - t_min;
-    floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (double)min_scale_px : GS_FIT_TINY_SCALE_PX;
+    floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
 
     switch (method) {
     case GS_FIT_PLAIN:
-        st = window_fit(&wn, NULL, W_PRIOR, 0.0, scratch_w, NULL, out);
+        st = window_fit(&wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out);
         break;
     case GS_FIT_IRLS:
-        st = fit_irls(&wn, m, floor_px, scratch_w, out);
+        st = fit_irls(&wn, m, floor_px, keep, out);
         break;
     case GS_FIT_RANSAC:
-        st = fit_ransac(&wn, m, floor_px, scratch_w, out);
+        st = fit_ransac(&wn, m, floor_px, keep, out);
         break;
     default:
         st = GS_EINVAL;
@@ -646,12 +680,12 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     }
     if (st != GS_OK) {
         for (i = 0; i < count; i++) {
-            scratch_w[i] = 0.0f;
+            keep_set(keep, i, false);
         }
         return st;
     }
     for (i = 0; i < count; i++) {
-        if (scratch_w[i] > 0.0f) {
+        if (gs_fit_kept(keep, i)) {
             n_pos++;
         }
     }

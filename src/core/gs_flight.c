@@ -6,7 +6,18 @@
  * as a one-sided deviation against gravity); the left side is grown from the
  * ring history when the flight closes. Take-off and landing are then refined
  * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
- * the boundary) and the final robust 2D fit uses only samples in free flight. */
+ * the boundary) and the final robust 2D fit uses only samples in free flight.
+ *
+ * float vs double (the Cortex-M4's FPU is single precision; double is emulated):
+ * what runs per sample inside the fits and per boundary candidate is gs_real
+ * (float there: test_sample, pred_var_factor, piecewise_ssr, solve_spd, and all
+ * of gs_fit.c). What stays double, and why:
+ *  - absolute times (t_s, T0, T1, last_t_s, peak_t, blk_t0, still_since, ...):
+ *    a stream runs for days and float seconds lose milliseconds after hours;
+ *  - the per-frame state machine (u, noise, levels, thresholds): a few dozen
+ *    operations a frame, kept double so hosts keep their exact results;
+ *  - closing a flight (event fields, SE, apex, jump height): once per flight,
+ *    and the event's public fields are double. */
 #include "gravscale/gs_flight.h"
 
 #include <math.h>
@@ -48,16 +59,35 @@
 #define STAND_SETTLE_S   0.2    /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      2.0    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
-static const gs_sample *at(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i); }
+/* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
+static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
+{
+    return gs_ring_get(f->ring, i, buf) ? buf : NULL;
+}
+
+/* time of ring sample i, NaN when not held */
+static double t_at(const gs_flight *f, uint64_t i)
+{
+    const gs_sample *s = gs_ring_at(f->ring, i);
+    return s ? gs_ring_sample_t_s(f->ring, s) : NAN;
+}
 
 /* Frames that weigh almost nothing (the COM lacks a whole segment, e.g. the head
  * out of the frame at the apex) take no part in detecting flights either. */
-static bool usable(const gs_sample *s)
+static bool usable(const gs_sample_full *s)
 {
     return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
 }
 
-static double u_of(const gs_flight *f, const gs_sample *s)
+static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
+
+static bool usable_at(const gs_flight *f, uint64_t i)
+{
+    gs_sample_full b;
+    return usable(at(f, i, &b));
+}
+
+static double u_of(const gs_flight *f, const gs_sample_full *s)
 {
     return (double)s->x_px * f->up_x + (double)s->y_px * f->up_y;
 }
@@ -130,13 +160,13 @@ static double med3(double a, double b, double c)
 }
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
-                         float *scratch_w, bool rigid, gs_event_fn on_event, void *ctx)
+                         uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
-    if (!f || !cfg || !ring || !scratch_w) return GS_EINVAL;
+    if (!f || !cfg || !ring || !keep) return GS_EINVAL;
     memset(f, 0, sizeof *f);
     f->cfg = cfg;
     f->ring = ring;
-    f->scratch_w = scratch_w;
+    f->keep = keep;
     f->rigid = rigid;
     f->on_event = on_event;
     f->ctx = ctx;
@@ -180,15 +210,15 @@ static double fit_sigma(const gs_flight *f, const gs_fit_result *r)
 }
 
 /* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) */
-static double pred_var_factor(const gs_fit *fit, double t_s)
+static gs_real pred_var_factor(const gs_fit *fit, double t_s)
 {
-    double tau = (t_s - fit->t0_s) / fit->tscale_s;
-    double x0 = 1.0, x1 = tau, x2 = tau * tau;
-    const double *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
-    if (r[0] == 0.0 || r[3] == 0.0 || r[5] == 0.0) return INFINITY;
-    double z0 = x0 / r[0];
-    double z1 = (x1 - r[1] * z0) / r[3];
-    double z2 = (x2 - r[2] * z0 - r[4] * z1) / r[5];
+    gs_real tau = (gs_real)((t_s - fit->t0_s) / fit->tscale_s);  /* absolute times meet in double */
+    gs_real x0 = GS_R(1.0), x1 = tau, x2 = tau * tau;
+    const gs_real *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
+    if (r[0] == GS_R(0.0) || r[3] == GS_R(0.0) || r[5] == GS_R(0.0)) return (gs_real)INFINITY;
+    gs_real z0 = x0 / r[0];
+    gs_real z1 = (x1 - r[1] * z0) / r[3];
+    gs_real z2 = (x2 - r[2] * z0 - r[4] * z1) / r[5];
     return z0 * z0 + z1 * z1 + z2 * z2;
 }
 
@@ -197,21 +227,23 @@ static double pred_var_factor(const gs_fit *fit, double t_s)
  * the deviation against gravity in units of its standard deviation (contact
  * pushes the body above the parabola, so z grows quadratically after it). */
 static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
-                        const gs_sample *s, double *z)
+                        const gs_sample_full *s, double *z)
 {
-    double dt = s->t_s - r->t0_s;
-    double px = r->x0_px + r->vx_px_s * dt + 0.5 * r->ax_px_s2 * dt * dt;
-    double py = r->y0_px + r->vy_px_s * dt + 0.5 * r->ay_px_s2 * dt * dt;
-    double ex = (double)s->x_px - px, ey = (double)s->y_px - py;
-    double gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
-    if (!isfinite(gx) || !isfinite(gy)) { gx = -f->up_x; gy = -f->up_y; }
-    double up = -(ex * gx + ey * gy);
-    double perp = ex * (-gy) + ey * gx;
-    double sig = fit_sigma(f, r);
-    double vf = pred_var_factor(fit, s->t_s);
-    double tot = sig * sqrt(1.0 + (isfinite(vf) ? vf : 1e6));
-    *z = up / tot;
-    return !(fabs(perp) > GROSS_OUTLIER * tot || up < -GROSS_OUTLIER * tot);
+    /* per sample and per boundary candidate: gs_real; only the time difference is double */
+    gs_real dt = (gs_real)(s->t_s - r->t0_s);
+    gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
+    gs_real px = (gs_real)r->x0_px + (gs_real)r->vx_px_s * dt + GS_R(0.5) * ax * dt * dt;
+    gs_real py = (gs_real)r->y0_px + (gs_real)r->vy_px_s * dt + GS_R(0.5) * ay * dt * dt;
+    gs_real ex = (gs_real)s->x_px - px, ey = (gs_real)s->y_px - py;
+    gs_real gx = ax / a, gy = ay / a;
+    if (!isfinite(gx) || !isfinite(gy)) { gx = (gs_real)-f->up_x; gy = (gs_real)-f->up_y; }
+    gs_real up = -(ex * gx + ey * gy);
+    gs_real perp = ex * (-gy) + ey * gx;
+    gs_real sig = (gs_real)fit_sigma(f, r);
+    gs_real vf = pred_var_factor(fit, s->t_s);
+    gs_real tot = sig * GS_SQRT(GS_R(1.0) + (isfinite(vf) ? vf : GS_R(1e6)));
+    *z = (double)(up / tot);
+    return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
 }
 
 /* one-sided CUSUM of z: contact raises it, noise drains it */
@@ -242,7 +274,8 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double si
     double max_ang = f->up_from_flight ? 25.0 : (f->up_n > 0 ? 40.0 : 60.0);
     max_ang += 2.0 * rel_se * 180.0 / GS_PI;
     if (max_ang > 80.0) max_ang = 80.0;
-    if (!(cosang > cos(max_ang * GS_PI / 180.0))) return false;
+    /* a threshold: single precision is plenty where double is emulated */
+    if (!(cosang > GS_COS(max_ang * GS_PI / 180.0))) return false;
     double a_hi = r->a_px_s2 + 2.0 * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - 2.0 * rel_se * r->a_px_s2;
     if (isfinite(size_px) && size_px > 0.0) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
@@ -259,7 +292,8 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double si
 static double gate_size(const gs_flight *f, uint64_t idx)
 {
     if (f->rigid) {
-        const gs_sample *s = at(f, idx);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, idx, &s_b);
         return s && isfinite(s->size_px) ? (double)s->size_px : NAN;
     }
     double se;
@@ -269,18 +303,20 @@ static double gate_size(const gs_flight *f, uint64_t idx)
 /* Rebuild the running fit robustly from the ring samples [lo, hi]. */
 static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
 {
-    const gs_sample *a = at(f, lo), *b = at(f, hi);
+    gs_sample_full a_b, b_b;
+    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
     if (!a || !b || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     gs_fit_result r;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->scratch_w, &r) != GS_OK)
+    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, &r) != GS_OK)
         return false;
     double tspan = b->t_s - a->t_s;
     gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
-        const gs_sample *s = at(f, i);
-        if (usable(s) && f->scratch_w[i - lo] > 0.0f) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
+        if (usable(s) && gs_fit_kept(f->keep, (uint32_t)(i - lo))) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
     }
     gs_fit_result chk;
     return gs_fit_solve(&f->fit, &chk) == GS_OK;
@@ -298,7 +334,8 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     if (r.rms_px / sqrt(2.0) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         double z;
         if (usable(s)) {
             if (test_sample(f, &f->fit, &r, s, &z)) {
@@ -323,7 +360,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
         uint32_t n = 0;
-        for (uint64_t i = lo; i <= hi; i++) n += usable(at(f, i)) ? 1u : 0u;
+        for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i) ? 1u : 0u;
         if (n >= 5) break;
         if (lo > f->quiet_from && lo > oldest) lo--;
         if (hi < newest) hi++;
@@ -331,7 +368,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
     uint32_t n_usable = 0;
-    for (uint64_t i = lo; i <= hi; i++) n_usable += usable(at(f, i)) ? 1u : 0u;
+    for (uint64_t i = lo; i <= hi; i++) n_usable += usable_at(f, i) ? 1u : 0u;
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
@@ -359,29 +396,31 @@ static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
 /* ---- boundary refinement with a piecewise model (1D, along up) ------------- */
 
 /* Solve the k x k (k <= 4) symmetric system A c = b by Cholesky; false if not PD. */
-static bool solve_spd(double A[4][4], double b[4], int k, double c[4])
+static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
 {
-    double L[4][4] = {{0}};
+    /* a pivot below this fraction of its diagonal: not positive definite at this precision */
+    const gs_real tiny = sizeof(gs_real) < sizeof(double) ? GS_R(1e-6) : GS_R(1e-12);
+    gs_real L[4][4] = {{0}};
     for (int i = 0; i < k; i++) {
         for (int j = 0; j <= i; j++) {
-            double s = A[i][j];
+            gs_real s = A[i][j];
             for (int m = 0; m < j; m++) s -= L[i][m] * L[j][m];
             if (i == j) {
-                if (!(s > 1e-12 * (A[i][i] > 0 ? A[i][i] : 1.0))) return false;
-                L[i][i] = sqrt(s);
+                if (!(s > tiny * (A[i][i] > 0 ? A[i][i] : GS_R(1.0)))) return false;
+                L[i][i] = GS_SQRT(s);
             } else {
                 L[i][j] = s / L[j][j];
             }
         }
     }
-    double y[4];
+    gs_real y[4];
     for (int i = 0; i < k; i++) {
-        double s = b[i];
+        gs_real s = b[i];
         for (int m = 0; m < i; m++) s -= L[i][m] * y[m];
         y[i] = s / L[i][i];
     }
     for (int i = k - 1; i >= 0; i--) {
-        double s = y[i];
+        gs_real s = y[i];
         for (int m = i + 1; m < k; m++) s -= L[m][i] * c[m];
         c[i] = s / L[i][i];
     }
@@ -396,40 +435,47 @@ static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double
                             double T, int side, double alpha_min_px, double alpha_max_px,
                             const gs_fit_result *r)
 {
-    double A[4][4] = {{0}}, b[4] = {0}, yy = 0.0;
+    /* called per boundary candidate and sample: gs_real. In float, u is taken about
+     * the first sample's (the SSR below is yy - c.b, which cancels), in double as is */
+    gs_real A[4][4] = {{0}}, b[4] = {0}, yy = GS_R(0.0);
+    gs_real u_c = GS_R(0.0);
+    bool have_c = sizeof(gs_real) == sizeof(double);
+    gs_real ts2 = (gs_real)(ts * ts);
     for (uint64_t i = lo; i <= hi; i++) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         double z;
         if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
-        double w = (double)s->w;
-        double tau = (s->t_s - tc) / ts;
-        double d = side < 0 ? (T - s->t_s) : (s->t_s - T);
-        double h = d > 0.0 ? 0.5 * d * d / (ts * ts) : 0.0;
-        double x[4] = {1.0, tau, tau * tau, h};
-        double u = u_of(f, s);
+        gs_real w = (gs_real)s->w;
+        gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
+        gs_real d = (gs_real)(side < 0 ? (T - s->t_s) : (s->t_s - T));
+        gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
+        gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
+        if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
+        gs_real u = (gs_real)u_of(f, s) - u_c;
         for (int k = 0; k < 4; k++) {
             b[k] += w * x[k] * u;
             for (int m = 0; m < 4; m++) A[k][m] += w * x[k] * x[m];
         }
         yy += w * u * u;
     }
-    double c[4];
-    double c3_min = alpha_min_px * ts * ts, c3_max = alpha_max_px * ts * ts;  /* alpha in tau units */
-    bool solved = A[3][3] > 0.0 && solve_spd(A, b, 4, c);
+    gs_real c[4];
+    gs_real c3_min = (gs_real)(alpha_min_px * ts * ts), c3_max = (gs_real)(alpha_max_px * ts * ts);  /* alpha in tau units */
+    bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
     if (solved && c[3] >= c3_min && c[3] <= c3_max) {
-        double ssr = yy;
+        gs_real ssr = yy;
         for (int k = 0; k < 4; k++) ssr -= c[k] * b[k];
-        return ssr > 0.0 ? ssr : 0.0;
+        return ssr > GS_R(0.0) ? (double)ssr : 0.0;
     }
     /* alpha at a bound: fit the parabola to u - alpha h */
-    double al = A[3][3] > 0.0 ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : 0.0;
-    double b3[4];
+    gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
+    gs_real b3[4];
     for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
-    double yy3 = yy - 2.0 * al * b[3] + al * al * A[3][3];
+    gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
     if (!solve_spd(A, b3, 3, c)) return INFINITY;
-    double ssr = yy3;
+    gs_real ssr = yy3;
     for (int k = 0; k < 3; k++) ssr -= c[k] * b3[k];
-    return ssr > 0.0 ? ssr : 0.0;
+    return ssr > GS_R(0.0) ? (double)ssr : 0.0;
 }
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples. */
@@ -438,8 +484,10 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
                               double alpha_max_px, double t_grown, double penalty,
                               const gs_fit_result *r)
 {
-    const gs_sample *a = at(f, lo), *b = at(f, hi);
-    const gs_sample *ei = at(f, edge_in), *eo = at(f, edge_out);
+    gs_sample_full a_b, b_b;
+    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
+    gs_sample_full ei_b, eo_b;
+    const gs_sample_full *ei = at(f, edge_in, &ei_b), *eo = at(f, edge_out, &eo_b);
     if (!a || !b || !ei || !eo) return NAN;
     double tc = 0.5 * (a->t_s + b->t_s), ts = 0.5 * (b->t_s - a->t_s);
     if (!(ts > 0.0)) return NAN;
@@ -496,7 +544,8 @@ static double rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, double *s
     uint32_t n = 0;
     uint64_t step = (hi - lo + MEDIAN_MAX) / MEDIAN_MAX;
     for (uint64_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (s && isfinite(s->size_px) && s->size_px > 0.0f) v[n++] = s->size_px;
     }
     return median_se(v, n, se_out);
@@ -514,14 +563,17 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     double S = 0.0;
     uint64_t oldest = gs_ring_oldest(f->ring);
     uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
-    const gs_sample *first = at(f, f->fl_first);
+    gs_sample_full first_b;
+    const gs_sample_full *first = at(f, f->fl_first, &first_b);
     double t_prev = first ? first->t_s : NAN;
-    const gs_sample *sd = at(f, f->seed_idx);
+    gs_sample_full sd_b;
+    const gs_sample_full *sd = at(f, f->seed_idx, &sd_b);
     uint64_t clean = f->fl_first;
     uint64_t i = f->fl_first;
     while (i > floor_idx) {
         i--;
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (!s) break;
         if (!usable(s)) continue;
         if (t_prev - s->t_s > max_gap) break;
@@ -575,7 +627,8 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
     while (n < CONTACT_SAMPLES_MAX) {
         if (side < 0) { if (i <= floor_idx) break; i--; }
         else { if (i + 1 >= head) break; i++; }
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (!usable(s)) continue;
         double z;
         if (!test_sample(f, &f->fit, r, s, &z)) continue;  /* a glitch: look past it */
@@ -614,7 +667,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
     double T0 = NAN, T1 = NAN;
     /* a flight longer than the ring holds has lost its edges: no refinement */
-    if (!at(f, L) || !at(f, R) || !at(f, lo) || !at(f, hi) || !at(f, first_left) || !at(f, first_right))
+    if (!held(f, L) || !held(f, R) || !held(f, lo) || !held(f, hi) || !held(f, first_left) || !held(f, first_right))
         n_left = n_right = 0;
     double amin = CONTACT_MIN_G * r.a_px_s2;
     double sig = fit_sigma(f, &r);
@@ -622,52 +675,56 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n_left >= 2)
-        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, at(f, L)->t_s, pen, &r);
+        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, t_at(f, L), pen, &r);
     else if (n_left == 1)
-        T0 = 0.5 * (at(f, first_left)->t_s + at(f, L)->t_s);
+        T0 = 0.5 * (t_at(f, first_left) + t_at(f, L));
     if (n_right >= 2)
-        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, at(f, R)->t_s, pen, &r);
+        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, t_at(f, R), pen, &r);
     else if (n_right == 1)
-        T1 = 0.5 * (at(f, first_right)->t_s + at(f, R)->t_s);
+        T1 = 0.5 * (t_at(f, first_right) + t_at(f, R));
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         n_left, n_right, T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
     uint64_t in_lo = lo, in_hi = hi;
     while (in_lo < in_hi) {
-        const gs_sample *s = at(f, in_lo);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, in_lo, &s_b);
         if (s && (!isfinite(T0) ? in_lo >= L : s->t_s > T0)) break;
         in_lo++;
     }
     while (in_hi > in_lo) {
-        const gs_sample *s = at(f, in_hi);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, in_hi, &s_b);
         if (s && (!isfinite(T1) ? in_hi <= R : s->t_s < T1)) break;
         in_hi--;
     }
     f->up_x = save_ux;
     f->up_y = save_uy;
 
-    const gs_sample *sf = at(f, in_lo), *sl = at(f, in_hi);
+    gs_sample_full sf_b, sl_b;
+    const gs_sample_full *sf = at(f, in_lo, &sf_b), *sl = at(f, in_hi, &sl_b);
     if (!sf || !sl || in_hi < in_lo) goto done;
     land_idx = in_hi + 1;
     uint32_t count = (uint32_t)(in_hi - in_lo + 1);
     gs_fit_result fr;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
-                                 f->scratch_w, &fr);
+                                 f->keep, &fr);
     trace_fit(f, "final", sf->t_s, sl->t_s, st == GS_OK ? &fr : NULL);
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
     double max_gap_in = 0.0, t_prev = NAN;
     for (uint64_t i = in_lo; i <= in_hi; i++) {
-        const gs_sample *s = at(f, i);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, i, &s_b);
         if (!s || !(s->w > 0.0f) || !isfinite(s->t_s)) continue;  /* frames missing from the source */
         if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
-        if (st == GS_OK && !(f->scratch_w[i - in_lo] > 0.0f)) n_out++;
+        if (st == GS_OK && !gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
@@ -767,7 +824,8 @@ done:
     if (land_idx != UINT64_MAX && land_idx < newest) f->quiet_from = land_idx;
     {
         /* next seeds start after the landing: restart the level trackers */
-        const gs_sample *s = at(f, newest);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, newest, &s_b);
         double u = s ? u_of(f, s) : NAN;
         f->blk_min_cur = isfinite(u) ? u : INFINITY;
         f->blk_min_prev = f->blk_min_cur;
@@ -779,20 +837,21 @@ done:
 
 /* ---- the per-sample state machine ------------------------------------------ */
 
-static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s);
+static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s);
 
 /* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
-static double speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample *s, double u)
+static double speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, double u)
 {
     uint64_t k = (uint64_t)ceil(0.1 / frame_dt(f));
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
-    const gs_sample *b = at(f, idx - k);
+    gs_sample_full b_b;
+    const gs_sample_full *b = at(f, idx - k, &b_b);
     if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
     return fabs(u - u_of(f, b)) / (s->t_s - b->t_s);
 }
 
-static void update_standing(gs_flight *f, const gs_sample *s, double speed)
+static void update_standing(gs_flight *f, const gs_sample_full *s, double speed)
 {
     if (!isfinite(speed)) return;
     if (f->rigid || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
@@ -824,7 +883,8 @@ static void update_standing(gs_flight *f, const gs_sample *s, double speed)
 
 double gs_flight_stand_at(const gs_flight *f, double t_s)
 {
-    if (!f || f->stand_n == 0 || !(f->stand_last_t == t_s)) return NAN;
+    /* the ring gives times back to the microsecond: same frame within half a millisecond */
+    if (!f || f->stand_n == 0 || !(fabs(f->stand_last_t - t_s) < 5e-4)) return NAN;
     return (double)f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
 }
 
@@ -838,7 +898,7 @@ void gs_flight_forget_body(gs_flight *f)
     if (!f->up_from_flight) f->up_n = 0;
 }
 
-static double size_ref(const gs_flight *f, const gs_sample *s)
+static double size_ref(const gs_flight *f, const gs_sample_full *s)
 {
     if (f->stand_n > 0) {
         uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
@@ -847,7 +907,7 @@ static double size_ref(const gs_flight *f, const gs_sample *s)
     return (isfinite(s->size_px) && s->size_px > 0.0f) ? (double)s->size_px : NAN;
 }
 
-static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
+static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     /* history for the median of three and second differences */
     if (f->n_hist == 3) {
@@ -922,13 +982,14 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
         set_state(f, GS_FS_AIRBORNE, apex_t);
         /* samples after the core that arrived meanwhile are tested in order */
         for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
-            const gs_sample *p = at(f, i);
+            gs_sample_full p_b;
+            const gs_sample_full *p = at(f, i, &p_b);
             if (usable(p)) airborne_sample(f, i, p);
         }
     }
 }
 
-static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample *s)
+static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_full *s)
 {
     /* the running fit may hold samples past the edge: rebuild it over the flight */
     refit_range(f, f->fl_first, f->fl_last);
@@ -936,11 +997,12 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample *s)
     set_state(f, GS_FS_GROUND, s->t_s);
 }
 
-static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
+static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
-    const gs_sample *seed = at(f, f->seed_idx);
+    gs_sample_full seed_b;
+    const gs_sample_full *seed = at(f, f->seed_idx, &seed_b);
     if (gs_fit_solve(&f->fit, &r) != GS_OK ||
         (seed && s->t_s - seed->t_s > (double)f->cfg->max_flight_s)) {
         land(f, idx, UINT64_MAX, s);
@@ -962,7 +1024,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    const gs_sample *edge = at(f, f->fl_last);
+    gs_sample_full edge_b;
+    const gs_sample_full *edge = at(f, f->fl_last, &edge_b);
     if (f->cusum > 0.0 && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
         land(f, idx, idx, s);
         return;
@@ -981,7 +1044,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample *s)
     if (f->cusum == 0.0) {
         /* everything pending was flight after all: take it in */
         for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
-            const gs_sample *p = at(f, j);
+            gs_sample_full p_b;
+            const gs_sample_full *p = at(f, j, &p_b);
             if (usable(p) && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
                 gs_fit_add(&f->fit, p->t_s, p->x_px, p->y_px, p->w);
         }
@@ -997,7 +1061,8 @@ void gs_flight_update(gs_flight *f)
     if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */
     while (f->next < head) {
         uint64_t idx = f->next++;
-        const gs_sample *s = at(f, idx);
+        gs_sample_full s_b;
+        const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
         bool present = s && s->w > 0.0f && isfinite(s->t_s);
@@ -1025,6 +1090,16 @@ void gs_flight_update(gs_flight *f)
         if (f->state == GS_FS_IDLE) set_state(f, GS_FS_GROUND, s->t_s);
         if (f->state == GS_FS_AIRBORNE) airborne_sample(f, idx, s);
         else ground_sample(f, idx, s);
+    }
+}
+
+void gs_flight_break(gs_flight *f)
+{
+    gs_flight_update(f);
+    /* what the next sample would do on seeing the gap, while the ring still holds the flight */
+    if (f->state == GS_FS_AIRBORNE) {
+        close_candidate(f, f->last_idx, UINT64_MAX, true);
+        set_state(f, GS_FS_GROUND, f->last_t_s);
     }
 }
 

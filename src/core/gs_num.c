@@ -1,7 +1,8 @@
 /* gs_num.c - decimal parsing and formatting without strtod/printf.
  * Parsing: a fast path (<= 19 digits in a uint64, exact powers of ten) and an
  * exact big-integer path for the rest. Formatting: exact decimal digits of the
- * binary value from a big integer, rounded half away from zero. */
+ * binary value from a big integer, rounded half away from zero.
+ * double: it is the number format of the lines (event fields are double). */
 #include "gravscale/gs_num.h"
 
 #include <limits.h>

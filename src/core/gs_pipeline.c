@@ -1,4 +1,5 @@
-/* gs_pipeline.c - keypoints -> COM sample -> ring -> flights -> aggregate -> events. */
+/* gs_pipeline.c - keypoints -> COM sample -> ring -> flights -> aggregate -> events.
+ * double: the caller's timestamps (absolute; the ring keeps 32-bit microseconds). */
 #include "gravscale/gs_pipeline.h"
 
 #include <math.h>
@@ -10,7 +11,8 @@ size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
 {
     if (!cfg) return 0;
     size_t cap = cfg->ring_capacity;
-    return ALIGN_UP(cap * sizeof(gs_sample), 8u) + ALIGN_UP(cap * sizeof(float), 8u);
+    /* the ring, then one bit per ring slot for the robust fits' inlier flags */
+    return ALIGN_UP(cap * sizeof(gs_sample), 8u) + ALIGN_UP((cap + 31u) / 32u * sizeof(uint32_t), 8u);
 }
 
 /* Flight events pass through here: accepted jumps feed the aggregate, which
@@ -50,7 +52,7 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     p->last_t_s = NAN;
     uint32_t cap = cfg->ring_capacity;
     gs_sample *samples = (gs_sample *)storage;
-    float *scratch = (float *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
+    uint32_t *scratch = (uint32_t *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
     gs_status st = gs_ring_init(&p->ring, samples, cap);
     if (st != GS_OK) return st;
     gs_agg_init(&p->agg);
@@ -82,7 +84,7 @@ static void emit_session(gs_pipeline *p, bool ended, const char *reason)
 
 /* A visit ends after a long absence or when someone else stands there; the
  * next one starts with its own aggregate and standing size. */
-static void track_session(gs_pipeline *p, const gs_sample *s)
+static void track_session(gs_pipeline *p, const gs_sample_full *s)
 {
     bool present = s->w >= 0.05f && isfinite(s->x_px) && isfinite(s->y_px);
     const char *why = NULL;
@@ -97,7 +99,7 @@ static void track_session(gs_pipeline *p, const gs_sample *s)
     if (r & GS_SESSION_STARTED) emit_session(p, false, NULL);
 }
 
-static gs_status push_sample(gs_pipeline *p, const gs_sample *s)
+static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
 {
     if (p->finished) return GS_ESTATE;
     if (!isfinite(s->t_s)) return GS_EINVAL;
@@ -105,9 +107,19 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample *s)
         if (s->t_s < p->last_t_s) return GS_EORDER;
         if (s->t_s == p->last_t_s) return GS_OK;  /* a repeated frame carries nothing new */
     }
+    int64_t us = gs_ring_time_us(&p->ring, s->t_s);
+    if (us == INT64_MIN) return GS_ERANGE;
+    if (p->n_frames > 0) {
+        /* the ring keeps whole microseconds: a frame within the same one adds nothing */
+        if (us <= p->ring.t_last_us) return GS_OK;
+        /* after a gap beyond the ring's time span its samples leave it: a flight
+         * left open must close on them first (as it would on any long gap) */
+        if (us - p->ring.t_last_us >= GS_RING_SPAN_US) gs_flight_break(&p->flight);
+    }
+    gs_status st = gs_ring_push(&p->ring, s);
+    if (st != GS_OK) return st;
     p->last_t_s = s->t_s;
     p->n_frames++;
-    gs_ring_push(&p->ring, s);
     if (p->flight.trace && p->on_event) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
@@ -131,7 +143,7 @@ gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp
     gs_com_out c;
     gs_status st = gs_com_compute(p->layout, p->cfg.mass_table, p->cfg.stature, p->cfg.min_conf, kp, &c);
     if (st != GS_OK) return st;
-    gs_sample s;
+    gs_sample_full s;
     s.t_s = t_s;
     s.x_px = c.x_px;
     s.y_px = c.y_px;
@@ -140,7 +152,6 @@ gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp
     s.up_x = c.up_x;
     s.up_y = c.up_y;
     s.upright = c.upright;
-    s.reserved = 0.0f;
     return push_sample(p, &s);
 }
 
@@ -148,7 +159,7 @@ gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y
                                  float c, float size_px)
 {
     if (!p) return GS_EINVAL;
-    gs_sample s;
+    gs_sample_full s;
     s.t_s = t_s;
     s.x_px = x_px;
     s.y_px = y_px;
@@ -157,7 +168,6 @@ gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y
     s.up_x = NAN;
     s.up_y = NAN;
     s.upright = 1.0f;
-    s.reserved = 0.0f;
     return push_sample(p, &s);
 }
 

@@ -1,6 +1,16 @@
-/* gs_ring.c - fixed-capacity ring of gs_sample in caller storage, addressed by
- * absolute sample index (head keeps counting past the capacity). */
+/* gs_ring.c - fixed-capacity ring of packed 16-byte samples in caller storage,
+ * addressed by absolute sample index (head keeps counting past the capacity). */
 #include "gravscale/gs_ring.h"
+
+#include <math.h>
+
+#define SIZE_FINE_Q 0x8000u      /* codes below: 1/16 px steps */
+#define SIZE_FINE_PX 2048.0f     /* ... up to here, then 1/4 px steps */
+#define SIZE_UNKNOWN 0xFFFFu
+#define UPRIGHT_STEPS 250.0f
+#define UPRIGHT_UNKNOWN 255u
+/* Beyond 2^62 us (146 000 years) from the base a time is refused: int64 stays safe. */
+#define TIME_MAX_US 4.6e18
 
 gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
 {
@@ -11,17 +21,137 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
     r->capacity = capacity;
     r->mask = capacity - 1u;
     r->head = 0;
+    r->valid_from = 0;
+    r->t_base_s = (double)NAN;
+    r->t_last_us = 0;
+    r->last_up_x = NAN;
+    r->last_up_y = NAN;
     return GS_OK;
 }
 
-void gs_ring_push(gs_ring *r, const gs_sample *s)
+int64_t gs_ring_time_us(const gs_ring *r, double t_s)
+{
+    if (!r || !isfinite(t_s)) {
+        return INT64_MIN;
+    }
+    /* the first sample becomes the base; double because it is an absolute time */
+    double base = isfinite(r->t_base_s) ? r->t_base_s : t_s;
+    double us = (t_s - base) * 1e6;
+    if (!(fabs(us) < TIME_MAX_US)) {
+        return INT64_MIN;
+    }
+    /* round half away from zero without libm's llround */
+    return us >= 0.0 ? (int64_t)(us + 0.5) : -(int64_t)(-us + 0.5);
+}
+
+static uint16_t size_pack(float size_px)
+{
+    if (!(size_px >= 0.0f)) {
+        return SIZE_UNKNOWN;
+    }
+    if (size_px < SIZE_FINE_PX - 1.0f / 32.0f) {
+        return (uint16_t)(size_px * 16.0f + 0.5f);
+    }
+    float q = (size_px - SIZE_FINE_PX) * 4.0f + 0.5f;
+    if (q < 0.0f) {
+        q = 0.0f;
+    }
+    /* larger than any sensor: unknown rather than a wrong number */
+    if (!(q < (float)(SIZE_UNKNOWN - SIZE_FINE_Q))) {
+        return SIZE_UNKNOWN;
+    }
+    return (uint16_t)(SIZE_FINE_Q + (uint32_t)q);
+}
+
+float gs_sample_size_px(const gs_sample *s)
+{
+    uint32_t q = s->size_q;
+    if (q == SIZE_UNKNOWN) {
+        return NAN;
+    }
+    if (q < SIZE_FINE_Q) {
+        return (float)q / 16.0f;
+    }
+    return SIZE_FINE_PX + (float)(q - SIZE_FINE_Q) / 4.0f;
+}
+
+static uint8_t w_pack(float w)
+{
+    if (!(w > 0.0f)) {
+        return 0;
+    }
+    if (!(w < 1.0f)) {
+        return 255;
+    }
+    uint32_t q = (uint32_t)(w * 255.0f + 0.5f);
+    return (uint8_t)(q == 0u ? 1u : q);  /* a usable frame stays usable */
+}
+
+float gs_sample_w(const gs_sample *s)
+{
+    return (float)s->w_q / 255.0f;
+}
+
+static uint8_t upright_pack(float u)
+{
+    if (isnan(u)) {
+        return UPRIGHT_UNKNOWN;
+    }
+    if (u <= 0.0f) {
+        return 0;
+    }
+    if (u >= 1.0f) {
+        return (uint8_t)UPRIGHT_STEPS;
+    }
+    /* floored: u >= 0.7 exactly when the code is >= 175 */
+    return (uint8_t)(u * UPRIGHT_STEPS);
+}
+
+float gs_sample_upright(const gs_sample *s)
+{
+    return s->upright_q == UPRIGHT_UNKNOWN ? NAN : (float)s->upright_q / UPRIGHT_STEPS;
+}
+
+gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
 {
     if (!r || !s || !r->buf) {
-        return;
+        return GS_EINVAL;
     }
-    /* The mask maps the absolute index to its slot; the oldest slot is simply reused. */
-    r->buf[(uint32_t)(r->head & r->mask)] = *s;
+    int64_t us = gs_ring_time_us(r, s->t_s);
+    if (us == INT64_MIN) {
+        return GS_EINVAL;
+    }
+    bool first = !isfinite(r->t_base_s);
+    if (!first && us < r->t_last_us) {
+        return GS_EORDER;
+    }
+    if (first) {
+        r->t_base_s = s->t_s;
+        us = 0;
+    } else if (us - r->t_last_us >= GS_RING_SPAN_US) {
+        r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
+    } else {
+        /* ages are exact below 2^32 us: drop the samples that reached the span */
+        uint32_t lo = (uint32_t)us;
+        uint64_t oldest = gs_ring_oldest(r);
+        while (oldest < r->head &&
+               (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
+            oldest++;
+        }
+        r->valid_from = oldest;
+    }
+    gs_sample *d = &r->buf[(uint32_t)(r->head & r->mask)];
+    d->t_us = (uint32_t)us;  /* modulo 2^32: read back relative to the newest */
+    d->x_px = s->x_px;
+    d->y_px = s->y_px;
+    d->size_q = size_pack(s->size_px);
+    d->w_q = w_pack(s->w);
+    d->upright_q = upright_pack(s->upright);
+    r->t_last_us = us;
+    r->last_up_x = s->up_x;
+    r->last_up_y = s->up_y;
     r->head++;
+    return GS_OK;
 }
 
 uint64_t gs_ring_oldest(const gs_ring *r)
@@ -29,7 +159,8 @@ uint64_t gs_ring_oldest(const gs_ring *r)
     if (!r) {
         return 0;
     }
-    return r->head > r->capacity ? r->head - r->capacity : 0;
+    uint64_t o = r->head > r->capacity ? r->head - r->capacity : 0;
+    return r->valid_from > o ? r->valid_from : o;
 }
 
 uint64_t gs_ring_head(const gs_ring *r)
@@ -51,4 +182,32 @@ const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i)
         return NULL;
     }
     return &r->buf[(uint32_t)(i & r->mask)];
+}
+
+double gs_ring_sample_t_s(const gs_ring *r, const gs_sample *s)
+{
+    /* held samples are less than 2^31 us older than the newest: the modular
+     * difference is their exact age, across any wrap of the 32-bit field */
+    uint32_t age = (uint32_t)r->t_last_us - s->t_us;
+    int64_t us = r->t_last_us - (int64_t)age;
+    /* double: an absolute time of a stream that may run for days */
+    return r->t_base_s + (double)us / 1e6;
+}
+
+bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)
+{
+    const gs_sample *s = gs_ring_at(r, i);
+    if (!s || !out) {
+        return false;
+    }
+    out->t_s = gs_ring_sample_t_s(r, s);
+    out->x_px = s->x_px;
+    out->y_px = s->y_px;
+    out->w = gs_sample_w(s);
+    out->size_px = gs_sample_size_px(s);
+    bool newest = i + 1u == r->head;
+    out->up_x = newest ? r->last_up_x : NAN;
+    out->up_y = newest ? r->last_up_y : NAN;
+    out->upright = gs_sample_upright(s);
+    return true;
 }

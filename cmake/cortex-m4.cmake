@@ -1,0 +1,23 @@
+# cortex-m4.cmake - cross toolchain for the core on a Cortex-M4F with Debian's
+# gcc-arm-none-eabi and newlib nano (libnewlib-arm-none-eabi). Used by the
+# `cortex-m4` preset (CMakePresets.json) and tools/firmware_size.sh.
+set(CMAKE_SYSTEM_NAME Generic)
+set(CMAKE_SYSTEM_PROCESSOR arm)
+set(CMAKE_C_COMPILER arm-none-eabi-gcc)
+set(CMAKE_ASM_COMPILER arm-none-eabi-gcc)
+# a bare-metal compiler cannot link a test program without startup code
+set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
+
+set(GS_M4_CPU_FLAGS "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16")
+set(CMAKE_C_FLAGS_INIT "${GS_M4_CPU_FLAGS} -ffunction-sections -fdata-sections")
+set(CMAKE_EXE_LINKER_FLAGS_INIT "${GS_M4_CPU_FLAGS} --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections")
+
+# libm by name: the driver picks the multilib for the flags above (a found path
+# would be the wrong, soft-float one)
+set(GS_LIBM m CACHE STRING "libm for the target")
+
+# look for libraries and headers in the target's tree only, programs on the host
+set(CMAKE_FIND_ROOT_PATH /usr/lib/arm-none-eabi)
+set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
+set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)

@@ -1,0 +1,98 @@
+/* fw_scenario.c - the firmware's workload: the core on static memory (a
+ * 512-sample ring), a profile parsed from flash, synthetic frames pushed one by
+ * one, every event formatted into a line buffer. No heap, no stdio. */
+#include "fw_scenario.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "gravscale/gravscale.h"
+
+#define FW_RING_CAP 512u
+#define FW_FPS 60.0
+
+/* ring + inlier bits, as gs_pipeline_storage_bytes computes for FW_RING_CAP */
+#define FW_STORAGE_BYTES (FW_RING_CAP * sizeof(gs_sample) + (FW_RING_CAP + 31u) / 32u * 4u)
+static uint64_t g_storage[(FW_STORAGE_BYTES + 7u) / 8u];  /* 8-byte aligned */
+static gs_pipeline g_pipe;
+static gs_core_config g_cfg;
+static char g_line[GS_EMIT_MAX];
+static fw_line_fn g_sink;
+static uint32_t g_status;
+
+static const char k_profile[] =
+    "[core]\n"
+    "fit = irls\n"
+    "ring_capacity = 512\n"
+    "size_min_m = 0.02\n"
+    "size_max_m = 2.5\n";
+
+static gs_status core_section(void *ctx, const char *key, size_t key_len, const char *value,
+                              size_t value_len, char *msg, size_t cap)
+{
+    return gs_core_config_set(ctx, key, key_len, value, value_len, msg, cap);
+}
+
+static void on_event(void *ctx, const gs_event *ev)
+{
+    (void)ctx;
+    size_t n = gs_emit(g_cfg.format, ev, g_line, sizeof g_line);
+    if (n > 0 && g_sink) g_sink(g_line, n);
+}
+
+/* height in metres of a ball bouncing with 0.45 s flights, at time t */
+static float bounce_m(float t)
+{
+    const float g = 9.81f, flight = 0.45f, v0 = 0.5f * g * flight;
+    float x = fmodf(t, flight + 0.15f);
+    if (x > flight) return 0.0f;  /* on the floor */
+    return v0 * x - 0.5f * g * x * x;
+}
+
+static void push_pose(double t, float y_off_px)
+{
+    /* a standing skeleton about 530 px tall, lifted by y_off_px */
+    static const float k_y[17] = {60, 52, 52, 56, 56, 110, 110, 190, 190, 260, 260, 290, 290, 400, 400, 530, 530};
+    static const float k_x[17] = {0, -6, 6, -14, 14, -40, 40, -48, 48, -50, 50, -22, 22, -24, 24, -24, 24};
+    gs_kp kp[17];
+    for (int i = 0; i < 17; i++) {
+        kp[i].x_px = 640.0f + k_x[i];
+        kp[i].y_px = 100.0f + k_y[i] - y_off_px;
+        kp[i].c = 0.9f;
+    }
+    g_status |= (uint32_t)gs_pipeline_push_keypoints(&g_pipe, t, kp);
+}
+
+uint32_t fw_scenario_run(bool pose, fw_line_fn line)
+{
+    gs_cfg_error err;
+    const gs_cfg_section sec = {"core", core_section, &g_cfg};
+    g_sink = line;
+    gs_core_config_default(&g_cfg);
+#ifndef FW_NO_PROFILE
+    g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
+#else
+    /* a compiled-in configuration: no text parser linked (measures its cost) */
+    (void)sec;
+    (void)err;
+    (void)k_profile;
+    g_cfg.size_min_m = 0.02f;
+    g_cfg.size_max_m = 2.5f;
+    g_status = 0;
+#endif
+    g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, pose ? GS_LAYOUT_COCO17 : GS_LAYOUT_POINT,
+                                           g_storage, sizeof g_storage, on_event, NULL);
+    const float q_m_per_px = 0.002f;
+    for (uint32_t i = 0; i < 6u * (uint32_t)FW_FPS; i++) {
+        /* a boot clock far from zero, so times are not small numbers */
+        double t = 1000.0 + (double)i / FW_FPS;
+        float h = bounce_m((float)i / (float)FW_FPS);
+        if (pose) {
+            push_pose(t, h / q_m_per_px);
+        } else {
+            g_status |= (uint32_t)gs_pipeline_push_point(&g_pipe, t, 320.0f, 400.0f - h / q_m_per_px, 1.0f, 34.35f);
+        }
+    }
+    g_status |= (uint32_t)gs_pipeline_flush(&g_pipe);
+    return g_status;
+}
