@@ -101,6 +101,7 @@ def main():
     ap.add_argument("--render", type=int, metavar="N", help="render a set of N clips first")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--outdir", help="where to render (with --render)")
+    ap.add_argument("--indices", help="with --render: only these clips of the set, e.g. 0,3,5")
     ap.add_argument("--set-args", default="", help="extra render_ball options for every clip, e.g. '--drag 0'")
     ap.add_argument("--program", default=os.path.join(ROOT, "build", "gravscale"))
     ap.add_argument("--renderer", default=os.path.join(ROOT, "build", "render_ball"))
@@ -133,8 +134,16 @@ def main():
             clip = render_clip(a.renderer, folder, a.render, a.seed, index_or_clip, a.set_args.split())
         return run_clip(a.program, clip, a.config)
 
-    items = list(range(a.render)) if a.render else sorted(
-        c for c in glob.glob(os.path.join(folder, "*.avi")) if os.path.exists(c[:-4] + ".json"))
+    if a.render and a.indices:
+        try:
+            items = sorted({int(x) for x in a.indices.split(",")})
+        except ValueError:
+            ap.error("--indices: whole numbers separated by commas")
+        if items[0] < 0 or items[-1] >= a.render:
+            ap.error("--indices: outside the set")
+    else:
+        items = list(range(a.render)) if a.render else sorted(
+            c for c in glob.glob(os.path.join(folder, "*.avi")) if os.path.exists(c[:-4] + ".json"))
     if not items:
         print("eval_ball: %s: no clips with truth" % folder, file=sys.stderr)
         return 1

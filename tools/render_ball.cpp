@@ -69,6 +69,8 @@ struct Params {
     int quality = 85;
     double wall_gap_m = 1.0;      // wall depth behind the ball
     int distractors = 1, moving_distractor = 1, shadow = 1;
+    int distractor_clear = 1;
+    double ambient = 0.45;        // shading: the unlit side's brightness (1: flat)     // keep the static distractors out of the ball's column
     double distractor_hue_deg = 120.0;
     uint64_t seed = 1;
     int preview_frame = -1;       // also write this frame as CLIP.preview.png
@@ -116,6 +118,8 @@ const Key kKeys[] = {
     {"distractors", nullptr, &Params::distractors, 0, 1},
     {"moving-distractor", nullptr, &Params::moving_distractor, 0, 1},
     {"shadow", nullptr, &Params::shadow, 0, 1},
+    {"ambient", &Params::ambient, nullptr, 0, 1},
+    {"distractor-clear", nullptr, &Params::distractor_clear, 0, 1},
     {"distractor-hue-deg", &Params::distractor_hue_deg, nullptr, 0, 360},
     {"preview-frame", nullptr, &Params::preview_frame, -1, 1e6},
 };
@@ -174,7 +178,7 @@ Params draw_set_clip(uint64_t seed, int n, int i)
     p.floor_frac = U(0.82, 0.92);
     double half_w_m = p.dist_m * std::tan(0.5 * p.hfov_deg * kPi / 180.0);
     p.x_m = U(-0.35, 0.35) * half_w_m;
-    p.vx_m_s = U(-0.15, 0.15);
+    p.vx_m_s = U(-0.05, 0.05);
     p.vz_m_s = U(-0.02, 0.02);
     p.release_s = U(0.25, 0.6);
     p.exposure_frac = U(0.5, 1.0);
@@ -421,7 +425,7 @@ struct Sphere {
 
 // Adds (with weight w) the sphere's coverage and shaded colour into acc (alpha in
 // channel 3), over the pixels it may touch. Returns false when off screen.
-void splat_sphere(const Scene &sc, const Sphere &s, double fuzz_m, double w, cv::Mat &acc)
+void splat_sphere(const Scene &sc, const Sphere &s, double fuzz_m, double w, cv::Mat &acc, double ambient = 0.45)
 {
     const Camera &cam = sc.cam;
     if (s.pc.z <= s.r * 1.5) return;
@@ -455,7 +459,7 @@ void splat_sphere(const Scene &sc, const Sphere &s, double fuzz_m, double w, cv:
             double t = d * std::cos(psi) - std::sqrt(std::max(0.0, s.r * s.r - dperp * dperp));
             V3 n = (1.0 / s.r) * (t * ray - s.pc);
             double lam = std::max(0.0, dot(n, sc.light));
-            double shade = 0.45 + 0.65 * lam;  // indoor: much fill light
+            double shade = ambient + (1.1 - ambient) * lam;  // indoor: much fill light
             // felt: a little darker towards the limb
             shade *= 0.9 + 0.1 * std::max(0.0, -dot(n, ray));
             float wa = static_cast<float>(w * a);
@@ -581,15 +585,31 @@ Scene build_scene(const Params &p, std::mt19937_64 &rng, std::vector<Distractor>
     // static green distractors: a ball on the floor, a plant, a box (all behind the ball)
     if (p.distractors) {
         cv::Mat acc(p.height, p.width, CV_32FC4, cv::Scalar::all(0));
+        // the image columns the ball sweeps (drifting at vx for the clip), with a margin
+        double d_px = cam.f * p.diam_m / p.dist_m;
+        double xa = p.x_m, xe = p.x_m + p.vx_m_s * p.duration_s;
+        double col0 = cam.cx + cam.f * std::min(xa, xe) / p.dist_m - 2.0 * d_px;
+        double col1 = cam.cx + cam.f * std::max(xa, xe) / p.dist_m + 2.0 * d_px;
+        // draws x at depth z (fraction of the half width in [-lim, lim]) whose image
+        // [x - half_m, x + half_m] keeps out of [col0, col1] when asked
+        auto place = [&](double z, double lim, double half_m) {
+            double hw = z * std::tan(0.5 * p.hfov_deg * kPi / 180.0), x = 0;
+            for (int k = 0; k < 60; k++) {
+                x = U(-lim, lim) * hw;
+                double u0 = cam.cx + cam.f * (x - half_m) / z, u1 = cam.cx + cam.f * (x + half_m) / z;
+                if (!p.distractor_clear || u1 < col0 || u0 > col1) break;
+            }
+            return x;
+        };
         double zr = U(p.dist_m + 0.15, sc.wall_z - 0.1);
         double rr = U(0.03, 0.06);
-        double xr = U(-0.6, 0.6) * zr * std::tan(0.5 * p.hfov_deg * kPi / 180.0);
+        double xr = place(zr, 0.6, rr);
         Distractor gb{{xr, rr, zr}, rr, hsv_bgr(p.distractor_hue_deg, U(0.6, 0.85), U(0.6, 0.8))};
         statics->push_back(gb);
         splat_sphere(sc, {cam.to_cam(gb.p), gb.r, gb.col}, 0.001, 1.0, acc);
         composite(sc.bg, acc, cv::Rect(0, 0, p.width, p.height));
         // plant: leaves (ellipses) around a stem, standing on the floor near the wall
-        double zp = sc.wall_z - 0.15, xp = U(-0.7, 0.7) * zp * std::tan(0.5 * p.hfov_deg * kPi / 180.0);
+        double zp = sc.wall_z - 0.15, xp = place(zp, 0.7, 0.3);
         double u, v, u2, v2;
         if (cam.project({xp, 0.0, zp}, &u, &v) && cam.project({xp, 0.6, zp}, &u2, &v2)) {
             double pxm = (v - v2) / 0.6;
@@ -607,7 +627,7 @@ Scene build_scene(const Params &p, std::mt19937_64 &rng, std::vector<Distractor>
             }
         }
         // a green box on the floor against the wall
-        double xb = U(-0.7, 0.7) * sc.wall_z * std::tan(0.5 * p.hfov_deg * kPi / 180.0);
+        double xb = place(sc.wall_z - 0.05, 0.7, 0.3) - 0.15;
         if (cam.project({xb, 0.0, sc.wall_z - 0.05}, &u, &v) && cam.project({xb + 0.3, 0.22, sc.wall_z - 0.05}, &u2, &v2)) {
             cv::Vec3f c = hsv_bgr(p.distractor_hue_deg - 10, 0.7, 0.55);
             cv::rectangle(sc.bg, cv::Point2d(u, v2), cv::Point2d(u2, v), cv::Scalar(c[0], c[1], c[2]), cv::FILLED,
@@ -762,7 +782,7 @@ int render(const Params &p, const std::string &out)
         for (int k = 0; k < nsub; k++) {
             double ts = t - 0.5 * expo + expo * (k + 0.5) / nsub;
             Sphere s{cam.to_cam(traj_at(tr, ts)), r, ball_col};
-            splat_sphere(sc, s, p.fuzz_m, 1.0 / nsub, acc);
+            splat_sphere(sc, s, p.fuzz_m, 1.0 / nsub, acc, p.ambient);
             Ellipse e = sphere_image(cam, s.pc, r);
             su += e.u / nsub;
             sv += e.v / nsub;
@@ -771,6 +791,11 @@ int render(const Params &p, const std::string &out)
             mark(e.u, e.v, reach + 2);
         }
         if (dirty.area()) {
+            if (fi == p.preview_frame && !moving) {  // the painter's coverage against the ellipse's area
+                Ellipse ep = sphere_image(cam, cam.to_cam(traj_at(tr, t)), r);
+                std::fprintf(stderr, "render_ball: frame %d: ball coverage %.1f px^2 (ellipse %.1f)\n", fi,
+                             cv::sum(acc(dirty))[3], 0.25 * kPi * ep.minor_px * ep.major_px);
+            }
             composite(img, acc, dirty);
             acc(dirty).setTo(cv::Scalar::all(0));
         }
