@@ -449,6 +449,21 @@ void test_basketball_keypoints(void)
     // the tracking ROI from landmarks 33/34 covers the same person as the detector's
     TEST_ASSERT_TRUE(dist((float)next.cx_px, (float)next.cy_px, (float)roi.cx_px, (float)roi.cy_px) < 0.15 * roi.size_px);
     TEST_ASSERT_TRUE(next.size_px > 0.7 * roi.size_px && next.size_px < 1.4 * roi.size_px);
+
+    // through the core's BlazePose-33 layout: he stands upright, hair top at
+    // y ~92, soles at y ~478 (measured): 386 px from vertex to floor. Measured
+    // with full: 369.7 px (-4.2 %): under the long trousers the network puts his
+    // right ankle, heel and toe 20-25 px above the shoe (y 438-454, shoe 468-480)
+    gs_com_out com;
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_com_compute(GS_LAYOUT_BLAZEPOSE33, GS_MASS_DELEVA, GS_STATURE_ANTHRO, 0.1f, o.kp, &com));
+    if (std::getenv("GS_TEST_VERBOSE"))
+        std::printf("core: stature %.1f px, COM (%.1f, %.1f) w %.2f up (%.2f, %.2f) upright %.2f\n", com.stature_px,
+                    com.x_px, com.y_px, com.w, com.up_x, com.up_y, com.upright);
+    TEST_ASSERT_FLOAT_WITHIN(0.05f * 386.0f, 386.0f, com.stature_px);
+    TEST_ASSERT_TRUE(com.w > 0.9f);
+    TEST_ASSERT_TRUE(com.up_y < -0.95f);  // the body axis points up the image
+    // the COM of a standing man lies near his hips (y ~290), between his legs
+    TEST_ASSERT_TRUE(com.x_px > 55 && com.x_px < 115 && com.y_px > 240 && com.y_px < 300);
 }
 
 void test_lite_and_heavy_on_both_photos(void)
