@@ -293,6 +293,9 @@ void test_config_keys(void)
     TEST_ASSERT_EQUAL_STRING("/opt/m/pose_detection.onnx", gs::pose_detector_path(c).c_str());
     TEST_ASSERT_EQUAL_INT(GS_OK, set_key(c, "min_tracking", "0.6"));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.6, c.min_tracking);
+    TEST_ASSERT_EQUAL_INT(GS_OK, set_key(c, "roi_smoothing", "on"));
+    TEST_ASSERT_TRUE(c.roi_smoothing);
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, set_key(c, "roi_smoothing", "1"));
     TEST_ASSERT_EQUAL_INT(GS_OK, set_key(c, "heatmap_refine", "off"));
     TEST_ASSERT_FALSE(c.heatmap_refine);
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, set_key(c, "model", "huge"));
@@ -489,42 +492,46 @@ void test_lite_and_heavy_on_both_photos(void)
 
 void test_tracking_skips_the_detector(void)
 {
-    gs::PoseConfig cfg = model_config(gs::PoseModel::lite);
     cv::Mat img = load_doc_image("messi5.jpg");
-    gs::PoseTracker t(cfg);
-    TEST_ASSERT_TRUE_MESSAGE(t.ok(), t.error().c_str());
-    gs::PoseOutput a, b, c;
-    TEST_ASSERT_TRUE(t.process(img, 0.0, &a));
-    TEST_ASSERT_TRUE(a.detector_ran);
-    TEST_ASSERT_TRUE(t.process(img, 1.0 / 30, &b));
-    TEST_ASSERT_FALSE(b.detector_ran);  // the ROI came from the previous landmarks
-    TEST_ASSERT_TRUE(b.det_score != b.det_score);  // NaN
-    TEST_ASSERT_EQUAL_DOUBLE(0.0, b.det_ms);
-    // same frame again, tracked: the smoothed ROI barely moves, so the keypoints
-    // repeat (lite, measured: worst 6.1 px, a foot point) and stay near those of
-    // the detector's ROI (worst 27 px = 6.2 % of the ROI, the stretched foot)
-    gs::PoseOutput b2;
-    TEST_ASSERT_TRUE(t.process(img, 2.0 / 30, &b2));
-    TEST_ASSERT_FALSE(b2.detector_ran);
-    float worst_rep = 0.0f, worst_det = 0.0f;
-    for (int k = 0; k < gs::kPoseKeypoints; k++) {
-        worst_rep = std::max(worst_rep, dist(b.kp[k].x_px, b.kp[k].y_px, b2.kp[k].x_px, b2.kp[k].y_px));
-        worst_det = std::max(worst_det, dist(a.kp[k].x_px, a.kp[k].y_px, b.kp[k].x_px, b.kp[k].y_px));
+    for (bool smooth : {false, true}) {
+        gs::PoseConfig cfg = model_config(gs::PoseModel::lite);
+        cfg.roi_smoothing = smooth;
+        gs::PoseTracker t(cfg);
+        TEST_ASSERT_TRUE_MESSAGE(t.ok(), t.error().c_str());
+        gs::PoseOutput a, b, b2, c;
+        TEST_ASSERT_TRUE(t.process(img, 0.0, &a));
+        TEST_ASSERT_TRUE(a.detector_ran);
+        TEST_ASSERT_TRUE(t.process(img, 1.0 / 30, &b));
+        TEST_ASSERT_FALSE(b.detector_ran);  // the ROI came from the previous landmarks
+        TEST_ASSERT_TRUE(b.det_score != b.det_score);  // NaN
+        TEST_ASSERT_EQUAL_DOUBLE(0.0, b.det_ms);
+        // the same frame again, tracked: the keypoints repeat up to the network's
+        // sensitivity to its crop, and stay near those of the detector's ROI.
+        // Measured (lite, worst of 33): repeat 13.7 px unsmoothed, 6.1 px with the
+        // smoothed ROI (ROI 442 px); vs the detector's ROI 27 px, the stretched foot
+        TEST_ASSERT_TRUE(t.process(img, 2.0 / 30, &b2));
+        TEST_ASSERT_FALSE(b2.detector_ran);
+        float worst_rep = 0.0f, worst_det = 0.0f;
+        for (int k = 0; k < gs::kPoseKeypoints; k++) {
+            worst_rep = std::max(worst_rep, dist(b.kp[k].x_px, b.kp[k].y_px, b2.kp[k].x_px, b2.kp[k].y_px));
+            worst_det = std::max(worst_det, dist(a.kp[k].x_px, a.kp[k].y_px, b.kp[k].x_px, b.kp[k].y_px));
+        }
+        if (std::getenv("GS_TEST_VERBOSE"))
+            std::printf("roi smoothing %s: tracked repeat worst %.2f px, tracked vs detector ROI worst %.1f px "
+                        "(%.1f %% of ROI %.0f px)\n", smooth ? "on" : "off", worst_rep, worst_det,
+                        100.0 * worst_det / a.roi.size_px, a.roi.size_px);
+        TEST_ASSERT_TRUE(worst_rep < (smooth ? 0.025f : 0.04f) * a.roi.size_px);
+        TEST_ASSERT_TRUE(worst_det < 0.10f * a.roi.size_px);
+        // a blank frame: tracking lost, the detector runs again on the same frame, nothing present
+        cv::Mat blank(img.size(), img.type(), cv::Scalar(40, 120, 40));
+        TEST_ASSERT_FALSE(t.process(blank, 3.0 / 30, &c));
+        TEST_ASSERT_TRUE(c.detector_ran);
+        TEST_ASSERT_TRUE(c.presence < cfg.min_tracking);
+        for (int k = 0; k < gs::kPoseKeypoints; k++) TEST_ASSERT_EQUAL_FLOAT(0.0f, c.kp[k].c);
+        // and the person is found again by the detector
+        TEST_ASSERT_TRUE(t.process(img, 4.0 / 30, &c));
+        TEST_ASSERT_TRUE(c.detector_ran);
     }
-    if (std::getenv("GS_TEST_VERBOSE"))
-        std::printf("tracked repeat worst %.2f px, tracked vs detector ROI worst %.1f px (%.1f %% of ROI %.0f px)\n",
-                    worst_rep, worst_det, 100.0 * worst_det / a.roi.size_px, a.roi.size_px);
-    TEST_ASSERT_TRUE(worst_rep < 0.025f * a.roi.size_px);
-    TEST_ASSERT_TRUE(worst_det < 0.10f * a.roi.size_px);
-    // a blank frame: tracking lost, the detector runs again on the same frame, nothing present
-    cv::Mat blank(img.size(), img.type(), cv::Scalar(40, 120, 40));
-    TEST_ASSERT_FALSE(t.process(blank, 3.0 / 30, &c));
-    TEST_ASSERT_TRUE(c.detector_ran);
-    TEST_ASSERT_TRUE(c.presence < cfg.min_tracking);
-    for (int k = 0; k < gs::kPoseKeypoints; k++) TEST_ASSERT_EQUAL_FLOAT(0.0f, c.kp[k].c);
-    // and the person is found again by the detector
-    TEST_ASSERT_TRUE(t.process(img, 4.0 / 30, &c));
-    TEST_ASSERT_TRUE(c.detector_ran);
 }
 
 void test_rotated_frame(void)
@@ -560,7 +567,7 @@ void test_rotated_frame(void)
     // 2. end to end: the detector finds the lying body and its ROI turns by ~90
     //    degrees; after a few tracked frames (the ROI from the landmarks) the
     //    keypoints land where they were upright (full, measured: nose,
-    //    shoulders and hips within 2.9 px, all 33 within 7.0 px; ROI 442 px)
+    //    shoulders and hips within 6.2 px, all 33 within 15.2 px; ROI 442 px)
     t.reset();
     for (int i = 0; i < 4; i++) {
         TEST_ASSERT_TRUE(t.process(rot, i / 30.0, &tu));

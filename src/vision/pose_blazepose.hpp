@@ -10,9 +10,10 @@
 // when the pose presence score drops below min_tracking (tracking lost); the
 // lost frame is retried with the detector at once, so no frame is skipped.
 // No landmark smoothing: the core fits the raw points (a filter would bend the
-// free-flight parabola). Only the ROI's two alignment points pass a one-euro
-// filter (as MediaPipe does), which steadies the crop of a still person; the
-// keypoints themselves stay raw. docs/pose.md has the details and numbers.
+// free-flight parabola). Optionally (roi_smoothing) the ROI's two alignment
+// points pass a one-euro filter as in MediaPipe, which steadies the crop of a
+// still person; off by default since it raised the COM's residual about the
+// flight parabola (docs/pose.md has the details and numbers).
 #ifndef GS_POSE_BLAZEPOSE_HPP
 #define GS_POSE_BLAZEPOSE_HPP
 
@@ -43,7 +44,8 @@ struct PoseConfig {
     double min_tracking = 0.5;     // pose presence below this = tracking lost
     double nms_iou = 0.3;          // detections overlapping more are merged (weighted NMS)
     bool heatmap_refine = true;    // refine x, y with the landmark heatmap (as MediaPipe)
-    bool roi_smoothing = true;     // one-euro filter on the tracked ROI's alignment points (not on keypoints)
+    bool roi_smoothing = false;    // one-euro filter on the tracked ROI's alignment points (never on keypoints);
+                                   // off: it steadies a still person's crop but raised the flight residuals (docs/pose.md)
 };
 
 // gs_cfg_handler for [pose]; ctx is a PoseConfig*. Keys: models, model,
