@@ -394,7 +394,7 @@ struct PoseTracker::Impl {
     OneEuro roi_filter[4];  // alignment points x0, y0, x1, y1 in ROI sizes
     double last_t_s = 0.0;
     double roi_unit_px = 1.0;
-    cv::Mat rgb_det, crop, blob;
+    cv::Mat rgb_det, det_half, crop, blob;
     double align[4] = {0, 0, 0, 0};  // the last landmarks' alignment points, image px
 
     // The next ROI from the filtered alignment points (values in units of the
@@ -485,7 +485,15 @@ struct PoseTracker::Impl {
         rgb_det.create(kDetSide, kDetSide, CV_8UC3);
         rgb_det.setTo(cv::Scalar::all(0));
         cv::Mat dst = rgb_det(cv::Rect(static_cast<int>(lb.pad_x), static_cast<int>(lb.pad_y), w, h));
-        cv::resize(bgr, dst, dst.size(), 0, 0, cv::INTER_AREA);
+        // area averaging against aliasing; a whole-factor step first keeps it
+        // cheap (1080p: 3 ms instead of 14); both steps map extents to extents
+        int k = static_cast<int>(std::floor(0.5 / std::max(lb.scale_x, lb.scale_y)));
+        if (k >= 2) {
+            cv::resize(bgr, det_half, cv::Size(bgr.cols / k, bgr.rows / k), 0, 0, cv::INTER_AREA);
+            cv::resize(det_half, dst, dst.size(), 0, 0, cv::INTER_AREA);
+        } else {
+            cv::resize(bgr, dst, dst.size(), 0, 0, cv::INTER_AREA);
+        }
         blob = cv::dnn::blobFromImage(rgb_det, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), true, false, CV_32F);
         det.setInput(blob);
         std::vector<cv::Mat> outs;
