@@ -506,8 +506,9 @@ struct PoseTracker::Impl {
 
     // Crop the rotated ROI to kLmSide x kLmSide, bilinear with replicated
     // borders as MediaPipe's CPU path. (Area-averaging large ROIs first, against
-    // aliasing, did not help: on the gym jump the COM's rms about the flight
-    // parabola went lite 3.97 -> 4.91 px, full 1.93 -> 1.85, heavy 2.70 -> 2.61.)
+    // aliasing, did not help: on the gym jump the COM's rms about a quadratic
+    // over frames 12-33 went lite 3.97 -> 4.91 px, full 1.93 -> 1.85, heavy
+    // 2.70 -> 2.61.)
     void crop_roi(const cv::Mat &bgr, const PoseRoi &r)
     {
         cv::warpAffine(bgr, crop, pose_roi_crop_to_image(r, kLmSide), cv::Size(kLmSide, kLmSide),

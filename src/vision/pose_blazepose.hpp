@@ -12,8 +12,9 @@
 // No landmark smoothing: the core fits the raw points (a filter would bend the
 // free-flight parabola). Optionally (roi_smoothing) the ROI's two alignment
 // points pass a one-euro filter as in MediaPipe, which steadies the crop of a
-// still person; off by default since it raised the COM's residual about the
-// flight parabola (docs/pose.md has the details and numbers).
+// still person; off by default: on the one real jump it raised the COM's
+// residual about the flight parabola for full and heavy (lowered it for lite;
+// docs/pose.md has the details and numbers).
 #ifndef GS_POSE_BLAZEPOSE_HPP
 #define GS_POSE_BLAZEPOSE_HPP
 
@@ -45,7 +46,7 @@ struct PoseConfig {
     double nms_iou = 0.3;          // detections overlapping more are merged (weighted NMS)
     bool heatmap_refine = true;    // refine x, y with the landmark heatmap (as MediaPipe)
     bool roi_smoothing = false;    // one-euro filter on the tracked ROI's alignment points (never on keypoints);
-                                   // off: it steadies a still person's crop but raised the flight residuals (docs/pose.md)
+                                   // off: it steadies a still person's crop, but the flight residuals were mixed (docs/pose.md)
 };
 
 // gs_cfg_handler for [pose]; ctx is a PoseConfig*. Keys: models, model,
