@@ -268,6 +268,13 @@ void test_decode_and_weighted_nms(void)
     TEST_ASSERT_FLOAT_WITHIN(1e-3f, 176 / 0.35 - 0.5, d[1].kp_x[0]);
     TEST_ASSERT_FLOAT_WITHIN(1e-3f, (48 + 10 - 28) / 0.35 - 0.5, d[1].kp_y[0]);
     TEST_ASSERT_FLOAT_WITHIN(1e-3f, (48 - 20 - 28) / 0.35 - 0.5, d[1].kp_y[1]);
+    // B's ROI: centre at its hip point, scale point 30 input px (85.7 image px)
+    // straight above: side 2 x 85.7 x 1.25, upright
+    gs::PoseRoi r = gs::pose_roi_from_alignment(d[1].kp_x[0], d[1].kp_y[0], d[1].kp_x[1], d[1].kp_y[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3, 176 / 0.35 - 0.5, r.cx_px);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3, 30 / 0.35 - 0.5, r.cy_px);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3, 2.0 * (30 / 0.35) * 1.25, r.size_px);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.0, r.rotation_rad);
     // a higher threshold keeps A only
     d = gs::pose_decode_detections(reg.data(), logit.data(), anchors, lb, 0.9, 0.3);
     TEST_ASSERT_EQUAL_UINT(1, (unsigned)d.size());
@@ -534,6 +541,31 @@ void test_tracking_skips_the_detector(void)
     }
 }
 
+void test_frame_types(void)
+{
+    gs::PoseConfig cfg = model_config(gs::PoseModel::lite);
+    gs::PoseTracker t(cfg);
+    TEST_ASSERT_TRUE_MESSAGE(t.ok(), t.error().c_str());
+    gs::PoseOutput o;
+    // basketball1.png is grey: read as one channel it is converted, same pose
+    std::string path = std::string(kDocData) + "basketball1.png";
+    cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE), bgra;
+    TEST_ASSERT_FALSE(grey.empty());
+    TEST_ASSERT_TRUE(t.process(grey, 0.0, &o));
+    TEST_ASSERT_TRUE(o.kp[NOSE].x_px > 78 && o.kp[NOSE].x_px < 104 && o.kp[NOSE].y_px > 106 && o.kp[NOSE].y_px < 134);
+    cv::cvtColor(grey, bgra, cv::COLOR_GRAY2BGRA);
+    t.reset();
+    TEST_ASSERT_TRUE(t.process(bgra, 0.0, &o));
+    // not 8-bit, empty, tiny: no pose, no crash, and the tracker still works
+    cv::Mat f32(480, 640, CV_32FC3, cv::Scalar::all(0.5)), tiny(1, 1, CV_8UC3, cv::Scalar::all(9));
+    TEST_ASSERT_FALSE(t.process(f32, 1.0, &o));
+    TEST_ASSERT_FALSE(t.process(cv::Mat(), 2.0, &o));
+    TEST_ASSERT_FALSE(t.process(tiny, 3.0, &o));
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, o.kp[0].c);
+    TEST_ASSERT_TRUE(t.process(grey, 4.0, &o));
+    TEST_ASSERT_TRUE(t.ok());
+}
+
 void test_rotated_frame(void)
 {
     // the photo turned 90 degrees clockwise, (x, y) -> (H - 1 - y, x)
@@ -612,6 +644,7 @@ int main(void)
     RUN_TEST(test_basketball_keypoints);
     RUN_TEST(test_lite_and_heavy_on_both_photos);
     RUN_TEST(test_tracking_skips_the_detector);
+    RUN_TEST(test_frame_types);
     RUN_TEST(test_rotated_frame);
     return UNITY_END();
 }

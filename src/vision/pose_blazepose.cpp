@@ -396,6 +396,25 @@ struct PoseTracker::Impl {
     double roi_unit_px = 1.0;
     cv::Mat rgb_det, det_half, crop, blob;
     double align[4] = {0, 0, 0, 0};  // the last landmarks' alignment points, image px
+    cv::Mat converted;                // a grey or BGRA frame as BGR
+
+    bool process(const cv::Mat &bgr, double t_s, PoseOutput *out);
+
+    // 8-bit BGR as is; 8-bit grey or BGRA converted; anything else: nullptr
+    const cv::Mat *as_bgr(const cv::Mat &img)
+    {
+        if (img.empty() || img.depth() != CV_8U) return nullptr;
+        if (img.channels() == 3) return &img;
+        if (img.channels() == 1) cv::cvtColor(img, converted, cv::COLOR_GRAY2BGR);
+        else if (img.channels() == 4) cv::cvtColor(img, converted, cv::COLOR_BGRA2BGR);
+        else return nullptr;
+        return &converted;
+    }
+    // an OpenCV error while running: kept (the first one), the frame gives no pose
+    void fail(const cv::Exception &e)
+    {
+        if (error.empty()) error = std::string("pose network failed: ") + e.what();
+    }
 
     // The next ROI from the filtered alignment points (values in units of the
     // ROI size when the track started, so the filter's speeds are scale-free).
@@ -630,22 +649,47 @@ void PoseTracker::reset() { p_->tracking = false; }
 
 std::vector<PoseDetection> PoseTracker::detect(const cv::Mat &bgr)
 {
-    if (!p_->ok || bgr.empty() || bgr.type() != CV_8UC3) return {};
-    return p_->detect(bgr);
+    const cv::Mat *img = p_->as_bgr(bgr);
+    if (!p_->ok || !img) return {};
+    try {
+        return p_->detect(*img);
+    } catch (const cv::Exception &e) {
+        p_->fail(e);
+        return {};
+    }
 }
 
 void PoseTracker::landmarks(const cv::Mat &bgr, const PoseRoi &roi, PoseOutput *out, PoseRoi *next_roi)
 {
     clear_output(out, 0.0);
-    if (!p_->ok || bgr.empty() || bgr.type() != CV_8UC3 || !(roi.size_px > 0.0)) return;
-    p_->landmarks(bgr, roi, out, next_roi);
+    const cv::Mat *img = p_->as_bgr(bgr);
+    if (!p_->ok || !img || !(roi.size_px > 0.0) || !std::isfinite(roi.cx_px) || !std::isfinite(roi.cy_px)) return;
+    try {
+        p_->landmarks(*img, roi, out, next_roi);
+    } catch (const cv::Exception &e) {
+        p_->fail(e);
+        clear_output(out, 0.0);
+    }
 }
 
 bool PoseTracker::process(const cv::Mat &bgr, double t_s, PoseOutput *out)
 {
     clear_output(out, t_s);
-    if (!p_->ok || bgr.empty() || bgr.type() != CV_8UC3) return false;
-    Impl &m = *p_;
+    const cv::Mat *img = p_->as_bgr(bgr);
+    if (!p_->ok || !img) return false;
+    try {
+        return p_->process(*img, t_s, out);
+    } catch (const cv::Exception &e) {
+        p_->fail(e);
+        p_->tracking = false;
+        clear_output(out, t_s);
+        return false;
+    }
+}
+
+bool PoseTracker::Impl::process(const cv::Mat &bgr, double t_s, PoseOutput *out)
+{
+    Impl &m = *this;
     // at most two attempts: the tracked ROI, then (when lost) a fresh detection
     for (int attempt = 0; attempt < 2; attempt++) {
         if (!m.tracking) {

@@ -145,10 +145,13 @@ public:
     PoseTracker(const PoseTracker &) = delete;
     PoseTracker &operator=(const PoseTracker &) = delete;
 
+    // ok(): the networks loaded. error(): why not, or the first OpenCV error
+    // while running (that frame gave no pose; the tracker goes on).
     bool ok() const;
     const std::string &error() const;
 
-    // One 8-bit BGR frame (any size); fills *out. Returns out->present.
+    // One 8-bit frame (BGR; grey and BGRA are converted), any size; fills *out.
+    // Returns out->present. Other types give no pose.
     bool process(const cv::Mat &bgr, double t_s, PoseOutput *out);
     // Forget the tracked person: the next frame runs the detector.
     void reset();
