@@ -11,8 +11,11 @@
 // 1080p frames are the same frames scaled to 1080 x 1920 (the cost of a larger
 // frame: letterbox and crop; the networks' inputs stay 224 and 256). Decoding
 // is not timed. Times are wall-clock per call, pre- and post-processing
-// included; the machine's load average is printed since other processes share
-// the cores.
+// included. Other processes share the cores here, so the load average is
+// printed and each figure also as CPU time of this process per call (all
+// threads): with 1 thread, about what the call takes on an idle core.
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -29,6 +32,13 @@
 #include "pose_blazepose.hpp"
 
 namespace {
+
+double cpu_ms()  // this process's CPU time, all threads: less sensitive to other load than wall time
+{
+    timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
 
 double now_ms()
 {
@@ -123,8 +133,8 @@ int main(int argc, char **argv)
     }
     std::printf("clip %s: %zu frames %dx%d; OpenCV %s; load average %.2f\n", clip.c_str(), frames.size(), w0, h0,
                 CV_VERSION, load[0]);
-    std::printf("%-6s %3s %6s | %-22s | %-22s | %s\n", "model", "thr", "frame", "detector ms mean/med/p90",
-                "landmark ms mean/med/p90", "tracker ms/frame  fps  detector runs");
+    std::printf("%-6s %3s %9s | %-27s | %-27s | %s\n", "model", "thr", "frame", "detector ms mean/med/p90/cpu",
+                "landmark ms mean/med/p90/cpu", "tracker ms/frame wall, cpu;  fps;  detector runs");
 
     for (int height : heights) {
         // the short side is 720 or 1080 ("720p", "1080p"), portrait or landscape as the clip
@@ -159,30 +169,35 @@ int main(int argc, char **argv)
 
                 // 1. every frame through the detector and the landmarks of its ROI
                 std::vector<double> det, lm;
+                double det_cpu = 0.0, lm_cpu = 0.0;
                 for (size_t i = 0; i < in.size(); i++) {
-                    double t0 = now_ms();
+                    double t0 = now_ms(), c0 = cpu_ms();
                     std::vector<gs::PoseDetection> d = t.detect(in[i]);
                     det.push_back(now_ms() - t0);
+                    det_cpu += cpu_ms() - c0;
                     if (d.empty()) continue;
                     gs::PoseRoi roi = gs::pose_roi_from_alignment(d[0].kp_x[0], d[0].kp_y[0], d[0].kp_x[1], d[0].kp_y[1]);
                     t0 = now_ms();
+                    c0 = cpu_ms();
                     t.landmarks(in[i], roi, &o, nullptr);
                     lm.push_back(now_ms() - t0);
+                    lm_cpu += cpu_ms() - c0;
                 }
                 // 2. the tracker as used: detector only when tracking is lost
                 t.reset();
                 int n_det = 0, n_present = 0;
-                double t0 = now_ms();
+                double t0 = now_ms(), c0 = cpu_ms();
                 for (size_t i = 0; i < in.size(); i++) {
                     t.process(in[i], i / 30.0, &o);
                     n_det += o.detector_ran;
                     n_present += o.present;
                 }
-                double per = (now_ms() - t0) / in.size();
+                double per = (now_ms() - t0) / in.size(), cpu = (cpu_ms() - c0) / in.size();
                 Stats sd = stats(det), sl = stats(lm);
-                std::printf("%-6s %3d %9s | %6.1f %6.1f %6.1f    | %6.1f %6.1f %6.1f    | %6.1f  %5.1f  %d of %zu (pose in %d)\n",
-                            gs::pose_model_name(m), th, res, sd.mean, sd.median, sd.p90, sl.mean, sl.median, sl.p90,
-                            per, 1000.0 / per, n_det, in.size(), n_present);
+                std::printf("%-6s %3d %9s | %6.1f %6.1f %6.1f %6.1f | %6.1f %6.1f %6.1f %6.1f | %6.1f %6.1f  %5.1f  %d of %zu (pose in %d)\n",
+                            gs::pose_model_name(m), th, res, sd.mean, sd.median, sd.p90, det_cpu / det.size(),
+                            sl.mean, sl.median, sl.p90, lm.empty() ? 0.0 : lm_cpu / lm.size(), per, cpu, 1000.0 / per,
+                            n_det, in.size(), n_present);
                 std::fflush(stdout);
             }
         }
