@@ -55,7 +55,9 @@ struct PoseConfig {
 gs_status pose_config_set(void *ctx, const char *key, size_t key_len, const char *value,
                           size_t value_len, char *msg, size_t cap);
 
-// The models folder in force for cfg (see PoseConfig) and the two files used.
+// The models folder in force for cfg (see PoseConfig) and the two files used:
+// pose_detection.onnx and pose_landmark_<model>_noseg.onnx when present (no
+// segmentation output, faster), else pose_landmark_<model>.onnx.
 std::string pose_models_dir(const PoseConfig &cfg);
 std::string pose_detector_path(const PoseConfig &cfg);
 std::string pose_landmark_path(const PoseConfig &cfg);
