@@ -15,6 +15,9 @@
 #include <string>
 #include <vector>
 
+#include <stdlib.h>  // mkdtemp
+#include <unistd.h>  // rmdir
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -327,6 +330,31 @@ void test_missing_models_named(void)
     cv::Mat img(64, 64, CV_8UC3, cv::Scalar::all(0));
     TEST_ASSERT_FALSE(t.process(img, 0.0, &o));  // no crash, nothing present
     TEST_ASSERT_EQUAL_FLOAT(0.0f, o.kp[0].c);
+
+    // a folder with the detector only: the landmark file is named; then a
+    // truncated landmark file: a load error naming it
+    char dir[] = "/tmp/gs_pose_models_XXXXXX";
+    TEST_ASSERT_NOT_NULL(mkdtemp(dir));
+    std::string d = dir, det = d + "/pose_detection.onnx", lm = d + "/pose_landmark_full.onnx";
+    std::FILE *f = std::fopen(det.c_str(), "wb");
+    TEST_ASSERT_NOT_NULL(f);
+    std::fputs("not a model", f);
+    std::fclose(f);
+    c.models_dir = d;
+    gs::PoseTracker t2(c);
+    TEST_ASSERT_FALSE(t2.ok());
+    TEST_ASSERT_NOT_NULL(std::strstr(t2.error().c_str(), lm.c_str()));
+    f = std::fopen(lm.c_str(), "wb");
+    TEST_ASSERT_NOT_NULL(f);
+    std::fputs("\x08\x07truncated", f);
+    std::fclose(f);
+    gs::PoseTracker t3(c);
+    TEST_ASSERT_FALSE(t3.ok());
+    TEST_ASSERT_NOT_NULL_MESSAGE(std::strstr(t3.error().c_str(), "cannot load pose model"), t3.error().c_str());
+    TEST_ASSERT_NOT_NULL(std::strstr(t3.error().c_str(), d.c_str()));
+    std::remove(det.c_str());
+    std::remove(lm.c_str());
+    ::rmdir(dir);
 }
 
 // ---- the networks on real photos ------------------------------------------------------
