@@ -693,33 +693,32 @@ bool PoseTracker::process(const cv::Mat &bgr, double t_s, PoseOutput *out)
 
 bool PoseTracker::Impl::process(const cv::Mat &bgr, double t_s, PoseOutput *out)
 {
-    Impl &m = *this;
-    // at most two attempts: the tracked ROI, then (when lost) a fresh detection
-    for (int attempt = 0; attempt < 2; attempt++) {
-        if (!m.tracking) {
-            double t0 = now_ms();
-            std::vector<PoseDetection> dets = m.detect(bgr);
-            out->det_ms += now_ms() - t0;
-            out->detector_ran = true;
-            if (dets.empty()) return false;
-            const PoseDetection &d = dets.front();  // the most confident person
-            out->det_score = d.score;
-            m.roi = pose_roi_from_alignment(d.kp_x[0], d.kp_y[0], d.kp_x[1], d.kp_y[1], kRoiScale);
-            m.tracking = true;
-            attempt = 1;  // a detector ROI gets no second try
-        }
+    // landmarks of the current ROI; true when the pose is there and the next ROI usable
+    auto track = [&]() {
         PoseRoi next;
         double t0 = now_ms();
-        m.landmarks(bgr, m.roi, out, &next);
+        landmarks(bgr, roi, out, &next);
         out->lm_ms += now_ms() - t0;
         if (out->present && next.size_px >= kMinRoiPx && std::isfinite(next.cx_px)) {
-            if (m.cfg.roi_smoothing) next = m.smooth_roi(next, t_s, out->detector_ran);
-            m.roi = next;
+            roi = cfg.roi_smoothing ? smooth_roi(next, t_s, out->detector_ran) : next;
             return true;
         }
-        m.tracking = false;
-        if (out->present) return true;  // valid now, but the next ROI is unusable: detect next frame
-    }
+        tracking = false;
+        return false;
+    };
+    if (tracking && track()) return true;
+    if (tracking || out->present) return out->present;  // present, but no usable next ROI: detect next frame
+    // no track (or lost on this frame): the detector, then the landmarks of its ROI
+    double t0 = now_ms();
+    std::vector<PoseDetection> dets = detect(bgr);
+    out->det_ms += now_ms() - t0;
+    out->detector_ran = true;
+    if (dets.empty()) return false;
+    const PoseDetection &d = dets.front();  // the most confident person
+    out->det_score = d.score;
+    roi = pose_roi_from_alignment(d.kp_x[0], d.kp_y[0], d.kp_x[1], d.kp_y[1], kRoiScale);
+    tracking = true;
+    track();
     return out->present;
 }
 
