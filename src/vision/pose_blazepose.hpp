@@ -1,0 +1,173 @@
+// pose_blazepose.hpp - BlazePose (MediaPipe's pose detector and landmark
+// networks, converted to ONNX at setup) run by OpenCV's DNN module: 33 body
+// keypoints per frame in image pixels for the core's BlazePose-33 layout.
+//
+// Per frame: when no person is tracked, the detector (224x224 letterbox) finds
+// one and its two alignment keypoints (hip centre, a point fixing scale and
+// rotation) give a rotated square ROI; the landmark network (256x256 crop of
+// that ROI) gives 39 points, of which 33 are the keypoints and 33/34 are the
+// alignment points for the next frame's ROI. The detector runs again only
+// when the pose presence score drops below min_tracking (tracking lost); the
+// lost frame is retried with the detector at once, so no frame is skipped.
+// No landmark smoothing: the core fits the raw points (a filter would bend the
+// free-flight parabola). Optionally (roi_smoothing) the ROI's two alignment
+// points pass a one-euro filter as in MediaPipe, which steadies the crop of a
+// still person; off by default: on the one real jump it raised the COM's
+// residual about the flight parabola for full and heavy (lowered it for lite;
+// docs/pose.md has the details and numbers).
+#ifndef GS_POSE_BLAZEPOSE_HPP
+#define GS_POSE_BLAZEPOSE_HPP
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+extern "C" {
+#include "gravscale/gs_config.h"
+#include "gravscale/gs_types.h"
+}
+
+namespace gs {
+
+enum class PoseModel { lite, full, heavy };
+const char *pose_model_name(PoseModel m);
+
+// The [pose] section. Models dir: models_dir if set (--models DIR or the
+// `models` key), else $GS_MODELS_DIR, else <source>/models (fetched at setup).
+struct PoseConfig {
+    std::string models_dir;
+    PoseModel model = PoseModel::lite;
+    int threads = 0;               // OpenCV threads (process-wide); 0 = leave OpenCV's default
+    double min_detection = 0.5;    // detector score that makes a person
+    double min_tracking = 0.5;     // pose presence below this = tracking lost
+    double nms_iou = 0.3;          // detections overlapping more are merged (weighted NMS)
+    bool heatmap_refine = true;    // refine x, y with the landmark heatmap (as MediaPipe)
+    bool roi_smoothing = false;    // one-euro filter on the tracked ROI's alignment points (never on keypoints);
+                                   // off: it steadies a still person's crop, but the flight residuals were mixed (docs/pose.md)
+};
+
+// gs_cfg_handler for [pose]; ctx is a PoseConfig*. Keys: models, model,
+// threads, min_detection, min_tracking, heatmap_refine (on|off),
+// roi_smoothing (on|off).
+gs_status pose_config_set(void *ctx, const char *key, size_t key_len, const char *value,
+                          size_t value_len, char *msg, size_t cap);
+
+// The models folder in force for cfg (see PoseConfig) and the two files used:
+// pose_detection.onnx and pose_landmark_<model>_noseg.onnx when present (no
+// segmentation output, faster), else pose_landmark_<model>.onnx.
+std::string pose_models_dir(const PoseConfig &cfg);
+std::string pose_detector_path(const PoseConfig &cfg);
+std::string pose_landmark_path(const PoseConfig &cfg);
+// true when both files exist; else false and err names the missing file and
+// how to get it.
+bool pose_models_present(const PoseConfig &cfg, std::string &err);
+
+// ---- geometry (pure functions, tested without the networks) -------------------
+
+// A rotated square in image pixels (OpenCV convention: pixel centres at integers).
+// rotation_rad turns the crop's x axis to (cos, sin) in the image (y down), so a
+// positive rotation is clockwise on screen; 0 = an upright person.
+struct PoseRoi {
+    double cx_px = 0.0, cy_px = 0.0;
+    double size_px = 0.0;
+    double rotation_rad = 0.0;
+};
+
+// MediaPipe's alignment-point rect: centre = (x0, y0), side = 2 x the distance
+// to (x1, y1) x scale (1.25 for BlazePose), rotated so that the vector
+// centre -> (x1, y1) points up in the crop (target angle 90 degrees).
+PoseRoi pose_roi_from_alignment(double x0_px, double y0_px, double x1_px, double y1_px,
+                                double scale = 1.25);
+
+// 2x3 affine (CV_64F) mapping crop pixels (side x side) to image pixels.
+cv::Mat pose_roi_crop_to_image(const PoseRoi &roi, int side);
+// A point given in the crop's normalised coordinates (0..1 across the ROI,
+// MediaPipe's convention) in image pixels.
+cv::Point2d pose_roi_to_image(const PoseRoi &roi, double xn, double yn);
+
+// SSD anchor centres of the detector (normalised 0..1; fixed size 1), in the
+// network's output order: 2254 for the 224 input (28x28x2, 14x14x2, 7x7x6).
+struct PoseAnchor {
+    float x, y;
+};
+std::vector<PoseAnchor> pose_detector_anchors();
+
+// One person found by the detector, in image pixels.
+struct PoseDetection {
+    float score = 0.0f;                      // sigmoid of the logit
+    float xmin = 0, ymin = 0, xmax = 0, ymax = 0;
+    float kp_x[4] = {0, 0, 0, 0}, kp_y[4] = {0, 0, 0, 0};  // 0 hip centre, 1 full-body scale point, 2/3 upper body
+};
+
+// Letterbox of a w x h image into the square detector input: image pixel
+// x = (u - pad_x) / scale_x - 0.5 for u in continuous input coordinates.
+struct PoseLetterbox {
+    double scale_x = 1.0, scale_y = 1.0;
+    double pad_x = 0.0, pad_y = 0.0;
+    int side = 224;
+};
+PoseLetterbox pose_letterbox(int width, int height, int side = 224);
+
+// Decode raw detector outputs (n x 12 regressors, n logits) against the anchors,
+// keep scores >= min_score, merge overlaps (weighted NMS, IoU > nms_iou), and
+// map to image pixels; best score first.
+std::vector<PoseDetection> pose_decode_detections(const float *regressors, const float *logits,
+                                                  const std::vector<PoseAnchor> &anchors,
+                                                  const PoseLetterbox &lb, double min_score,
+                                                  double nms_iou);
+
+// ---- the tracker ---------------------------------------------------------------
+
+constexpr int kPoseKeypoints = 33;
+
+struct PoseOutput {
+    double t_s = 0.0;
+    bool present = false;      // landmarks valid this frame
+    bool detector_ran = false; // the detector ran this frame (start, or tracking lost)
+    float presence = 0.0f;     // pose presence score of the landmark network 0..1; NaN not run
+    float det_score = 0.0f;    // score of the detection used; NaN when the detector did not run
+    gs_kp kp[kPoseKeypoints];  // image px; c = visibility x in_frame (0 when !present)
+    float z_px[kPoseKeypoints];       // depth relative to the hips, in image px at the ROI's scale; < 0 nearer the camera; NaN none
+    float visibility[kPoseKeypoints]; // sigmoid of the visibility logit (not occluded)
+    float in_frame[kPoseKeypoints];   // sigmoid of the presence logit (inside the image)
+    PoseRoi roi;               // the crop the landmarks came from
+    double det_ms = 0.0;       // this frame's detector time (pre- and post-processing included)
+    double lm_ms = 0.0;        // this frame's landmark time
+};
+
+class PoseTracker {
+public:
+    // Loads the two networks; on failure ok() is false and error() says why
+    // (missing file with how to get it, or a load error).
+    explicit PoseTracker(const PoseConfig &cfg);
+    ~PoseTracker();
+    PoseTracker(const PoseTracker &) = delete;
+    PoseTracker &operator=(const PoseTracker &) = delete;
+
+    // ok(): the networks loaded. error(): why not, or the first OpenCV error
+    // while running (that frame gave no pose; the tracker goes on).
+    bool ok() const;
+    const std::string &error() const;
+
+    // One 8-bit frame (BGR; grey and BGRA are converted), any size; fills *out.
+    // Returns out->present. Other types give no pose.
+    bool process(const cv::Mat &bgr, double t_s, PoseOutput *out);
+    // Forget the tracked person: the next frame runs the detector.
+    void reset();
+
+    // The networks alone, for tests and benchmarks: every detection in the frame,
+    // and the landmarks of a given ROI (present set from the presence score).
+    std::vector<PoseDetection> detect(const cv::Mat &bgr);
+    void landmarks(const cv::Mat &bgr, const PoseRoi &roi, PoseOutput *out, PoseRoi *next_roi);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> p_;
+};
+
+}  // namespace gs
+
+#endif
