@@ -10,6 +10,7 @@ typedef enum {
     GS_EV_HEIGHT,    /* running aggregate after each accepted flight */
     GS_EV_SUMMARY,   /* end of stream: the run's final answer */
     GS_EV_SESSION,   /* a person's visit started or ended (body layouts) */
+    GS_EV_WARNING,   /* guidance: a condition started (camera moved, body left the frame); from the front end */
     GS_EV_STATE,     /* trace: state machine change */
     GS_EV_SAMPLE,    /* trace: one COM sample */
     GS_EV_FIT        /* trace: one fit attempt (window and result) */
@@ -79,6 +80,12 @@ typedef struct {
 } gs_ev_session;
 
 typedef struct {
+    uint32_t track;
+    double t_s;
+    uint32_t warnings;         /* GS_WARN_* bits that started at t_s */
+} gs_ev_warning;
+
+typedef struct {
     double t_s;
     const char *from, *to;
 } gs_ev_state;
@@ -102,6 +109,7 @@ typedef struct {
         gs_ev_jump jump;
         gs_ev_height height;   /* GS_EV_HEIGHT and GS_EV_SUMMARY */
         gs_ev_session session;
+        gs_ev_warning warning;
         gs_ev_state state;
         gs_ev_sample sample;
         gs_ev_fit fit;

@@ -15,8 +15,11 @@
 
 #include <unistd.h>
 
+#include "camera_motion.hpp"
 #include "frame_source.hpp"
 #include "overlay.hpp"
+#include "pose_blazepose.hpp"
+#include "scene_watch.hpp"
 
 #if __has_include("ball_detector.hpp")
 #include "ball_detector.hpp"
@@ -41,20 +44,29 @@ constexpr size_t kTraceBufBytes = 1u << 16;
 const char kHelp[] =
     "usage: gravscale video FILE [OPTIONS]\n"
     "\n"
-    "Detect a ball in a video (any container FFmpeg reads) or an image sequence,\n"
-    "follow its free flights and print every flight, the running size and a final\n"
-    "summary per ball as JSON Lines (or NMEA sentences), as `gravscale replay`\n"
-    "does. For a ball, height_m is its diameter.\n"
+    "Detect a ball or a person in a video (any container FFmpeg reads) or an image\n"
+    "sequence, follow the free flights and print every flight, the running size and\n"
+    "a final summary as JSON Lines (or NMEA sentences), as `gravscale replay` does.\n"
+    "For a ball, height_m is its diameter; for a person, the stature.\n"
     "\n"
     "  FILE                 a video file, a folder of images (in name order) or a\n"
     "                       printf pattern such as frames/%05d.png\n"
-    "  --detector D         ball (the default and, for now, the only one)\n"
+    "  --detector D         ball (the default) or pose (BlazePose keypoints, one\n"
+    "                       person: visits, jumps, stature; warnings when the camera\n"
+    "                       moves, the body leaves the frame or moves in depth)\n"
+    "  --model M            pose network: lite (default), full or heavy\n"
+    "  --models DIR         folder of the converted pose networks (default: models/\n"
+    "                       of the source tree, made by tools/fetch_models.sh)\n"
+    "  --threads N          OpenCV threads for the pose networks (default: OpenCV's)\n"
+    "  --stabilize on|off   pose: map keypoints into the first frame's view using the\n"
+    "                       background's motion (default on; flights still carry\n"
+    "                       camera_moved when the camera moved)\n"
     "  --fps N              the true frame rate: stream times are rescaled to N\n"
     "                       frames per second of real time (slow-motion clips stored\n"
     "                       at a false rate); required for an image sequence.\n"
     "                       Default: the capture rate a phone stored in the\n"
     "                       metadata (com.android.capture.fps), else the stream's\n"
-    "  --config FILE        key = value configuration, sections [core] and [ball]\n"
+    "  --config FILE        key = value configuration, sections [core], [ball], [pose]\n"
     "  --output-format F    json | nmea (default: json, or [core] format)\n"
     "  --trace FILE         also write every event, trace events included, as JSON\n"
     "                       Lines to FILE\n"
@@ -73,6 +85,9 @@ const char kHelp[] =
 
 struct Options {
     std::string input, config, trace, overlay, plot, detector = "ball";
+    std::string model, models;
+    int threads = -1;              // -1: from the config
+    bool stabilize = true;
     double fps = 0.0;
     bool out_format_set = false;
     gs_format out_format = GS_FMT_JSON;
@@ -87,8 +102,9 @@ int usage_error(const std::string &msg)
 // -1 to go on, else an exit code
 int parse_args(int argc, char **argv, Options &o)
 {
-    static const char *const known[] = {"--detector", "--fps",     "--config", "--output-format",
-                                        "--trace",    "--overlay", "--plot"};
+    static const char *const known[] = {"--detector", "--fps",     "--config", "--output-format", "--trace",
+                                        "--overlay",  "--plot",    "--model",  "--models",        "--threads",
+                                        "--stabilize"};
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
@@ -112,8 +128,22 @@ int parse_args(int argc, char **argv, Options &o)
             val = argv[++i];
         }
         if (name == "--detector") {
-            if (val != "ball") return usage_error("--detector must be ball, not '" + val + "'");
+            if (val != "ball" && val != "pose") return usage_error("--detector must be ball or pose, not '" + val + "'");
             o.detector = val;
+        } else if (name == "--model") {
+            if (val != "lite" && val != "full" && val != "heavy")
+                return usage_error("--model must be lite, full or heavy, not '" + val + "'");
+            o.model = val;
+        } else if (name == "--models") {
+            o.models = val;
+        } else if (name == "--threads") {
+            double t;
+            if (!gs_num_parse(val.c_str(), val.size(), &t) || t != std::floor(t) || t < 0 || t > 64)
+                return usage_error("--threads must be a whole number 0..64, not '" + val + "'");
+            o.threads = static_cast<int>(t);
+        } else if (name == "--stabilize") {
+            if (val != "on" && val != "off") return usage_error("--stabilize must be on or off, not '" + val + "'");
+            o.stabilize = val == "on";
         } else if (name == "--fps") {
             double f;
             if (!gs_num_parse(val.c_str(), val.size(), &f) || !(f > 0.0) || !(f <= 100000.0))
@@ -134,6 +164,8 @@ int parse_args(int argc, char **argv, Options &o)
         }
     }
     if (o.input.empty()) return usage_error("a video file or image sequence is required");
+    if (o.detector != "pose" && (!o.model.empty() || !o.models.empty() || o.threads >= 0))
+        return usage_error("--model, --models and --threads belong to --detector pose");
     return -1;
 }
 
@@ -148,12 +180,14 @@ void print_cfg_error(const std::string &path, const gs_cfg_error &e)
     std::fprintf(stderr, "%s %s\n", (e.section[0] || e.key[0]) ? ":" : "", e.msg[0] ? e.msg : "invalid configuration");
 }
 
-int load_config(const std::string &path, gs_core_config &cfg, gs::BallConfig &ball)
+int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::BallConfig &ball,
+                gs::PoseConfig &pose)
 {
     gs_core_config_default(&cfg);
-    // a ball is small: its size range, unless the file says otherwise
-    cfg.size_min_m = 0.02f;
-    cfg.size_max_m = 0.5f;
+    if (!person) {  // a ball is small: its size range, unless the file says otherwise
+        cfg.size_min_m = 0.02f;
+        cfg.size_max_m = 0.5f;
+    }
     if (path.empty()) return EXIT_OK;
     FILE *f = std::fopen(path.c_str(), "rb");
     if (!f) {
@@ -173,7 +207,9 @@ int load_config(const std::string &path, gs_core_config &cfg, gs::BallConfig &ba
                      static_cast<unsigned>(kConfigMaxBytes));
         return EXIT_USAGE;
     }
-    const gs_cfg_section sections[] = {{"core", gs_core_config_set, &cfg}, {"ball", gs::ball_config_set, &ball}};
+    const gs_cfg_section sections[] = {{"core", gs_core_config_set, &cfg},
+                                       {"ball", gs::ball_config_set, &ball},
+                                       {"pose", gs::pose_config_set, &pose}};
     gs_cfg_error e;
     std::memset(&e, 0, sizeof e);
     gs_status st = gs_cfg_parse(text.data(), n, sections, sizeof sections / sizeof sections[0], &e);
@@ -202,6 +238,8 @@ struct App {
     bool trace_on = false;
     uint32_t emit_fail = 0;
     gs::RunRecord rec;
+    gs::SceneWatch *watch = nullptr;  // pose: per-flight warnings from the frames
+    std::vector<gs_ev_jump> person_jumps;  // pose: accepted flights as printed
 };
 
 bool is_trace_event(gs_event_type t) { return t == GS_EV_STATE || t == GS_EV_SAMPLE || t == GS_EV_FIT; }
@@ -249,6 +287,51 @@ void on_event(void *ctx, const gs_event *ev)
 {
     App &a = *static_cast<App *>(ctx);
     char buf[GS_EMIT_MAX];
+    gs_event marked;
+    if (ev->type == GS_EV_JUMP && a.watch) {  // what the frames say about this flight
+        marked = *ev;
+        gs_ev_jump &j = marked.u.jump;
+        j.warnings |= a.watch->flight_warnings(j.t_takeoff_s, j.t_land_s, j.t_apex_s);
+        // a jumper's flight is the feet's: off the ground to back on it; its height by the
+        // jump-test convention h = g T^2 / 8 (the COM's rise differs by the body's shape change)
+        double t0, t1, g = j.q_m_per_px * j.a_px_s2;
+        if (a.watch->feet_flight(j.t_takeoff_s, j.t_land_s, j.a_px_s2, &t0, &t1) &&
+            std::fabs(t0 - j.t_takeoff_s) < 0.15 && std::fabs(t1 - j.t_land_s) < 0.15) {
+            j.t_takeoff_s = t0;
+            j.t_land_s = t1;
+            j.flight_time_s = t1 - t0;
+            if (std::isfinite(g)) {
+                j.jump_height_m = g * j.flight_time_s * j.flight_time_s / 8.0;
+                j.takeoff_velocity_m_s = 0.5 * g * j.flight_time_s;
+            }
+        }
+        if (j.accepted) a.person_jumps.push_back(j);
+        ev = &marked;
+    } else if (ev->type == GS_EV_SESSION && a.watch && ev->u.session.ended) {
+        // the visit's jump figures from the flights as printed (feet timing), not the core's
+        marked = *ev;
+        gs_ev_session &e = marked.u.session;
+        double best_h = NAN, sum_h = 0, best_t = NAN, sum_t = 0, sum_v = 0;
+        int n = 0;
+        for (const gs_ev_jump &j : a.person_jumps) {
+            if (j.t_land_s < e.t_start_s - 1.0 || j.t_takeoff_s > e.t_end_s + 1.0) continue;
+            if (!std::isfinite(j.jump_height_m) || !std::isfinite(j.flight_time_s)) continue;
+            if (!(j.jump_height_m <= best_h)) best_h = j.jump_height_m;
+            if (!(j.flight_time_s <= best_t)) best_t = j.flight_time_s;
+            sum_h += j.jump_height_m;
+            sum_t += j.flight_time_s;
+            sum_v += j.takeoff_velocity_m_s;
+            n++;
+        }
+        if (n > 0 && (uint32_t)n == e.n_jumps) {
+            e.best_jump_m = best_h;
+            e.mean_jump_m = sum_h / n;
+            e.best_flight_s = best_t;
+            e.mean_flight_s = sum_t / n;
+            e.mean_takeoff_velocity_m_s = sum_v / n;
+        }
+        ev = &marked;
+    }
     // a track other than 0 that never had a flight (a distractor followed for a
     // moment) gets no summary; track 0 always does, with a null size if need be
     if (ev->type == GS_EV_SUMMARY && ev->u.height.track != 0 && ev->u.height.n_jumps == 0 &&
@@ -278,7 +361,7 @@ struct TrackPipe {
 
 class Pipelines {
 public:
-    Pipelines(const gs_core_config &cfg, App &app) : cfg_(cfg), app_(app) {}
+    Pipelines(const gs_core_config &cfg, gs_layout layout, App &app) : cfg_(cfg), layout_(layout), app_(app) {}
     // nullptr when the pipeline cannot start (reported once)
     gs_pipeline *get(uint32_t track)
     {
@@ -286,7 +369,7 @@ public:
             auto tp = std::make_unique<TrackPipe>();
             size_t bytes = gs_pipeline_storage_bytes(&cfg_);
             tp->storage.assign(bytes / sizeof(double) + 1, 0.0);
-            gs_status st = gs_pipeline_init(&tp->p, &cfg_, GS_LAYOUT_POINT, tp->storage.data(),
+            gs_status st = gs_pipeline_init(&tp->p, &cfg_, layout_, tp->storage.data(),
                                             tp->storage.size() * sizeof(double), on_event, &app_);
             if (st != GS_OK) {
                 init_error_ = st;
@@ -309,6 +392,7 @@ public:
 
 private:
     gs_core_config cfg_;
+    gs_layout layout_;
     App &app_;
     std::vector<std::unique_ptr<TrackPipe>> pipes_;
     gs_status init_error_ = GS_OK;
@@ -370,14 +454,100 @@ int write_overlay(const Options &o, const gs::FrameSourceOptions &fo, const gs::
     return EXIT_OK;
 }
 
+// BlazePose keypoints that mark the body's top and bottom (for the border test)
+constexpr int kBlazeEnds[] = {0, 2, 5, 7, 8, 27, 28, 29, 30, 31, 32};
+
+// The person path's per-frame work: pose, camera motion, stabilised keypoints.
+struct PersonFront {
+    gs::PoseTracker pose;
+    gs::CameraMotion cam;
+    gs::SceneWatch watch;
+    bool stabilize = true;
+    explicit PersonFront(const gs::PoseConfig &pc) : pose(pc) {}
+
+    // one frame -> keypoints for the core (c = 0 when no body); records the scene facts
+    void frame(const cv::Mat &bgr, double t_s, gs_kp *kp, gs::SceneFrame *sf, gs::PoseOutput *po)
+    {
+        pose.process(bgr, t_s, po);
+        std::vector<cv::Rect> ex;
+        float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+        if (po->present) {
+            for (int k = 0; k < gs::kPoseKeypoints; k++) {
+                x0 = std::min(x0, po->kp[k].x_px);
+                y0 = std::min(y0, po->kp[k].y_px);
+                x1 = std::max(x1, po->kp[k].x_px);
+                y1 = std::max(y1, po->kp[k].y_px);
+            }
+            ex.push_back(cv::Rect(cv::Point((int)x0, (int)y0), cv::Point((int)x1 + 1, (int)y1 + 1)));
+        }
+        gs::CameraMotionFrame cm;
+        cam.process(bgr, ex, &cm);
+        *sf = gs::SceneFrame();
+        sf->t_s = t_s;
+        sf->cam_valid = cm.valid;
+        sf->cam_dx_px = cm.dx_px;
+        sf->cam_dy_px = cm.dy_px;
+        sf->present = po->present;
+        sf->ground_y_px = NAN;
+        sf->size_px = NAN;
+        for (int k = 0; k < gs::kPoseKeypoints; k++) {
+            kp[k] = po->kp[k];
+            if (!po->present) kp[k].c = 0.0f;
+        }
+        if (!po->present) return;
+        sf->size_px = y1 - y0;
+        const float mx = 2.0f;  // a point this close to the border is cut by it
+        for (int k : kBlazeEnds) {
+            const gs_kp &p = po->kp[k];
+            bool out = p.x_px < mx || p.y_px < mx || p.x_px > bgr.cols - 1 - mx || p.y_px > bgr.rows - 1 - mx;
+            if (out || po->in_frame[k] < 0.5f) sf->at_border = true;
+        }
+        // the feet's row: the lower of the two heels, when both are seen
+        if (po->visibility[29] > 0.5f && po->visibility[30] > 0.5f)
+            sf->ground_y_px = std::max(po->kp[29].y_px, po->kp[30].y_px);
+        if (stabilize && cm.valid) {
+            for (int k = 0; k < gs::kPoseKeypoints; k++) {
+                cv::Point2d r = cam.to_reference(cv::Point2d(kp[k].x_px, kp[k].y_px));
+                kp[k].x_px = static_cast<float>(r.x);
+                kp[k].y_px = static_cast<float>(r.y);
+            }
+        }
+        // the toes (foot index 31, 32) in the core's coordinates: they leave the ground last and meet it first
+        sf->feet_y_px = (po->visibility[31] > 0.3f && po->visibility[32] > 0.3f)
+                            ? 0.5 * ((double)kp[31].y_px + (double)kp[32].y_px) : NAN;
+    }
+};
+
 int run(const Options &o)
 {
+    const bool person = o.detector == "pose";
     gs_core_config cfg;
     gs::BallConfig ball_cfg;
-    int rc = load_config(o.config, cfg, ball_cfg);
+    gs::PoseConfig pose_cfg;
+    int rc = load_config(o.config, person, cfg, ball_cfg, pose_cfg);
     if (rc != EXIT_OK) return rc;
+    if (!o.model.empty())
+        pose_cfg.model = o.model == "full" ? gs::PoseModel::full : o.model == "heavy" ? gs::PoseModel::heavy
+                                                                                      : gs::PoseModel::lite;
+    if (!o.models.empty()) pose_cfg.models_dir = o.models;
+    if (o.threads >= 0) pose_cfg.threads = o.threads;
 
     std::signal(SIGPIPE, SIG_IGN);  // a closed pipe shows as EPIPE on write
+
+    std::unique_ptr<PersonFront> front;
+    if (person) {
+        std::string merr;
+        if (!gs::pose_models_present(pose_cfg, merr)) {
+            std::fprintf(stderr, "gravscale: %s\n", merr.c_str());
+            return EXIT_USAGE;
+        }
+        front.reset(new PersonFront(pose_cfg));
+        if (!front->pose.ok()) {
+            std::fprintf(stderr, "gravscale: pose networks: %s\n", front->pose.error().c_str());
+            return EXIT_USAGE;
+        }
+        front->stabilize = o.stabilize;
+    }
 
     gs::FrameSourceOptions fo;
     fo.fps = o.fps;
@@ -391,6 +561,7 @@ int run(const Options &o)
 
     App app;
     app.fmt = o.out_format_set ? o.out_format : cfg.format;
+    if (front) app.watch = &front->watch;
     gs_out_open_fd(&app.out, STDOUT_FILENO, 0);
     if (!o.trace.empty()) {
         if (gs_out_open_path(&app.trace, o.trace.c_str(), kTraceBufBytes) != 0) {
@@ -404,7 +575,9 @@ int run(const Options &o)
     app.rec.fps = src->fps();
     app.rec.fps_origin = src->fps_origin();
     app.rec.frame_size = src->size();
+    app.rec.person = person;
 
+    const gs_layout layout = person ? GS_LAYOUT_BLAZEPOSE33 : GS_LAYOUT_POINT;
     gs_event ev;
     std::memset(&ev, 0, sizeof ev);
     ev.type = GS_EV_START;
@@ -412,11 +585,12 @@ int run(const Options &o)
     ev.u.start.config = o.config.empty() ? "default" : o.config.c_str();
     ev.u.start.fps_source = src->fps() > 0.0 ? src->fps() : NAN;
     ev.u.start.fps_origin = src->fps_origin();
-    ev.u.start.layout = gs_layout_name(GS_LAYOUT_POINT);
+    ev.u.start.layout = gs_layout_name(layout);
     on_event(&app, &ev);
 
-    Pipelines pipes(cfg, app);
-    gs::BallDetector det(ball_cfg);
+    Pipelines pipes(cfg, layout, app);
+    std::unique_ptr<gs::BallDetector> det;
+    if (!person) det.reset(new gs::BallDetector(ball_cfg));
     std::vector<gs::BallObs> obs;
     gs::Frame f;
     const bool keep = !o.overlay.empty() || !o.plot.empty();
@@ -425,22 +599,58 @@ int run(const Options &o)
     bool shown = false;
     while (!app.out.err && src->next(f)) {
         if (f.bgr.size() != app.rec.frame_size) app.rec.frame_size = f.bgr.size();
-        obs.clear();
-        det.process(f.bgr, f.t_s, obs);
         app.rec.frame_t.push_back(f.t_s);
         app.rec.frame_obs.emplace_back();
-        for (const gs::BallObs &b : obs) {
-            if (b.track < 0) continue;
-            if (keep) app.rec.frame_obs.back().push_back({b.track, b.x_px, b.y_px, b.diameter_px, b.confidence});
-            gs_pipeline *p = pipes.get(static_cast<uint32_t>(b.track));
+        if (person) {
+            gs_kp kp[gs::kPoseKeypoints];
+            gs::SceneFrame sf;
+            gs::PoseOutput po;
+            front->frame(f.bgr, f.t_s, kp, &sf, &po);
+            front->watch.add(sf);
+            if (keep) {
+                app.rec.frame_kp.emplace_back();
+                if (po.present) {
+                    for (int k = 0; k < gs::kPoseKeypoints; k++)
+                        app.rec.frame_kp.back().push_back(cv::Point3f(po.kp[k].x_px, po.kp[k].y_px, po.kp[k].c));
+                    // the COM drawn where it is in this frame (the core gets it stabilised)
+                    gs_com_out c;
+                    if (gs_com_compute(GS_LAYOUT_BLAZEPOSE33, cfg.mass_table, cfg.stature, cfg.min_conf, po.kp, &c) ==
+                            GS_OK && std::isfinite(c.x_px))
+                        app.rec.frame_obs.back().push_back({0, c.x_px, c.y_px, NAN, c.w});
+                }
+            }
+            gs_pipeline *p = pipes.get(0);
             if (!p) {
                 std::fprintf(stderr, "gravscale: cannot start the pipeline: %s\n", gs_status_str(pipes.init_error()));
                 return EXIT_USAGE;
             }
-            gs_status st = gs_pipeline_push_point(p, f.t_s, static_cast<float>(b.x_px), static_cast<float>(b.y_px),
-                                                  static_cast<float>(b.confidence),
-                                                  static_cast<float>(b.diameter_px));
+            gs_status st = gs_pipeline_push_keypoints(p, f.t_s, kp);
             if (st != GS_OK && pipes.refused++ == 0) pipes.first_refusal = st;
+            uint32_t on = front->watch.onsets();
+            if (on) {  // guidance: a condition just started
+                std::memset(&ev, 0, sizeof ev);
+                ev.type = GS_EV_WARNING;
+                ev.u.warning.t_s = f.t_s;
+                ev.u.warning.warnings = on;
+                on_event(&app, &ev);
+            }
+        } else {
+            obs.clear();
+            det->process(f.bgr, f.t_s, obs);
+            for (const gs::BallObs &b : obs) {
+                if (b.track < 0) continue;
+                if (keep) app.rec.frame_obs.back().push_back({b.track, b.x_px, b.y_px, b.diameter_px, b.confidence});
+                gs_pipeline *p = pipes.get(static_cast<uint32_t>(b.track));
+                if (!p) {
+                    std::fprintf(stderr, "gravscale: cannot start the pipeline: %s\n",
+                                 gs_status_str(pipes.init_error()));
+                    return EXIT_USAGE;
+                }
+                gs_status st = gs_pipeline_push_point(p, f.t_s, static_cast<float>(b.x_px),
+                                                      static_cast<float>(b.y_px), static_cast<float>(b.confidence),
+                                                      static_cast<float>(b.diameter_px));
+                if (st != GS_OK && pipes.refused++ == 0) pipes.first_refusal = st;
+            }
         }
         if (progress && (f.index & 15) == 0 && now_s() > next_progress) {
             next_progress = now_s() + 0.25;

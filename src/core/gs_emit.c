@@ -95,6 +95,20 @@ static size_t w_finish(gs_w *w)
 static const char *const k_warn_names[] = {"few_samples", "gravity_tilt", "size_changed", "outliers",
                                            "edge_truncated", "camera_moved", "left_frame", "out_of_plane"};
 
+/* ,"warnings":[names of the known set bits, in bit order] */
+static void w_warnings(gs_w *w, uint32_t bits)
+{
+    w_lit(w, ",\"warnings\":[");
+    bool first = true;
+    for (uint32_t b = 0; b < sizeof k_warn_names / sizeof k_warn_names[0]; b++) {
+        if (!(bits & (1u << b))) continue;
+        if (!first) w_raw(w, ",", 1);
+        w_jstr(w, k_warn_names[b]);
+        first = false;
+    }
+    w_lit(w, "]");
+}
+
 static void json_jump(gs_w *w, const gs_ev_jump *j)
 {
     w_lit(w, "{\"event\":\"jump\",\"track\":");
@@ -135,15 +149,8 @@ static void json_jump(gs_w *w, const gs_ev_jump *j)
     w_fixed(w, j->rms_px, 3);
     w_lit(w, j->accepted ? ",\"accepted\":true,\"reason\":" : ",\"accepted\":false,\"reason\":");
     w_jstr(w, j->accepted ? NULL : gs_reject_reason_name(j->reason));
-    w_lit(w, ",\"warnings\":[");
-    bool first = true;
-    for (uint32_t b = 0; b < sizeof k_warn_names / sizeof k_warn_names[0]; b++) {
-        if (!(j->warnings & (1u << b))) continue;
-        if (!first) w_raw(w, ",", 1);
-        w_jstr(w, k_warn_names[b]);
-        first = false;
-    }
-    w_lit(w, "]}\n");
+    w_warnings(w, j->warnings);
+    w_lit(w, "}\n");
 }
 
 static void json_height(gs_w *w, const gs_ev_height *h, bool summary)
@@ -235,6 +242,14 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
     case GS_EV_HEIGHT: json_height(&w, &ev->u.height, false); break;
     case GS_EV_SUMMARY: json_height(&w, &ev->u.height, true); break;
     case GS_EV_SESSION: json_session(&w, &ev->u.session); break;
+    case GS_EV_WARNING:
+        w_lit(&w, "{\"event\":\"warning\",\"track\":");
+        w_u32(&w, ev->u.warning.track);
+        w_lit(&w, ",\"t_s\":");
+        w_fixed(&w, ev->u.warning.t_s, 4);
+        w_warnings(&w, ev->u.warning.warnings);
+        w_lit(&w, "}\n");
+        break;
     case GS_EV_STATE: {
         const gs_ev_state *s = &ev->u.state;
         w_lit(&w, "{\"event\":\"state\",\"t_s\":");
@@ -375,6 +390,16 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
         n_num(&w, e->best_jump_m, 3, 5);
         n_num(&w, e->mean_jump_m, 3, 5);
         n_num(&w, e->mean_flight_s, 3, 5);
+        break;
+    }
+    case GS_EV_WARNING: {
+        static const char hexd[] = "0123456789ABCDEF";
+        uint32_t b = ev->u.warning.warnings & 0xFFu;
+        char hx[2] = {hexd[b >> 4], hexd[b & 15u]};
+        w_lit(&w, "$GSWRN");
+        n_num(&w, ev->u.warning.t_s, 3, 10);
+        w_raw(&w, ",", 1);
+        w_raw(&w, hx, 2);  /* the GS_WARN_* bits in hex */
         break;
     }
     case GS_EV_START:

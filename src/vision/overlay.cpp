@@ -115,6 +115,8 @@ void fit_jump_curves(RunRecord &r)
     }
 }
 
+static std::string subject_name(const RunRecord &r) { return r.person ? "person" : "ball"; }
+
 void draw_overlay(cv::Mat &img, const RunRecord &r, int64_t index)
 {
     if (img.empty() || index < 0 || index >= static_cast<int64_t>(r.frame_t.size())) return;
@@ -138,7 +140,7 @@ void draw_overlay(cv::Mat &img, const RunRecord &r, int64_t index)
                        static_cast<int>(14 * s), th, cv::LINE_AA);
         std::string txt = "#" + std::to_string(j.index) + " a=" + fmt("%.0f", j.a_px_s2) + " px/s2 q=" +
                           fmt("%.3f", j.q_m_per_px * 1000.0) + " mm/px ";
-        txt += j.accepted ? "d=" + fmt("%.1f", j.height_m * 100.0) + " cm" : "rejected: " + j.reason;
+        txt += j.accepted ? (r.person ? "h=" : "d=") + fmt("%.1f", j.height_m * 100.0) + " cm" : "rejected: " + j.reason;
         label(img, txt, cv::Point(static_cast<int>(apex.x + 12 * s), static_cast<int>(apex.y - 10 * s)), ts, c, th / 2 + 1);
     }
 
@@ -151,15 +153,31 @@ void draw_overlay(cv::Mat &img, const RunRecord &r, int64_t index)
                        cv::LINE_AA, kShift);
         }
     }
+    if (fi < r.frame_kp.size() && r.frame_kp[fi].size() == 33) {
+        // BlazePose's skeleton: face, arms, trunk, legs and feet
+        static const int bones[][2] = {{11, 12}, {11, 13}, {13, 15}, {12, 14}, {14, 16}, {11, 23}, {12, 24},
+                                       {23, 24}, {23, 25}, {25, 27}, {24, 26}, {26, 28}, {27, 29}, {29, 31},
+                                       {27, 31}, {28, 30}, {30, 32}, {28, 32}, {0, 2},   {0, 5},   {2, 7},
+                                       {5, 8},   {9, 10}};
+        const std::vector<cv::Point3f> &k = r.frame_kp[fi];
+        for (const auto &b : bones) {
+            if (k[b[0]].z < 0.3f || k[b[1]].z < 0.3f) continue;
+            cv::line(img, fx({k[b[0]].x, k[b[0]].y}), fx({k[b[1]].x, k[b[1]].y}), kWhite, th, cv::LINE_AA, kShift);
+        }
+        for (const cv::Point3f &p : k)
+            if (p.z >= 0.3f)
+                cv::circle(img, fx({p.x, p.y}), static_cast<int>(3 * s) << kShift, kAccepted, -1, cv::LINE_AA, kShift);
+    }
     for (const ObsRecord &o : r.frame_obs[fi]) {
         cv::Scalar c = track_color(o.track);
-        cv::circle(img, fx({o.x_px, o.y_px}), static_cast<int>(std::lround(0.5 * o.diameter_px * (1 << kShift))), c,
-                   th, cv::LINE_AA, kShift);
+        if (std::isfinite(o.diameter_px))
+            cv::circle(img, fx({o.x_px, o.y_px}), static_cast<int>(std::lround(0.5 * o.diameter_px * (1 << kShift))),
+                       c, th, cv::LINE_AA, kShift);
         cv::drawMarker(img, cv::Point(static_cast<int>(o.x_px), static_cast<int>(o.y_px)), c, cv::MARKER_CROSS,
                        static_cast<int>(8 * s), 1, cv::LINE_AA);
-        label(img, "ball " + std::to_string(o.track) + " " + fmt("%.1f", o.diameter_px) + " px",
-              cv::Point(static_cast<int>(o.x_px + 0.5 * o.diameter_px + 6 * s), static_cast<int>(o.y_px)), ts, c,
-              th / 2 + 1);
+        double rad = std::isfinite(o.diameter_px) ? 0.5 * o.diameter_px : 0.0;
+        label(img, r.person ? std::string("COM") : "ball " + std::to_string(o.track) + " " + fmt("%.1f", o.diameter_px) + " px",
+              cv::Point(static_cast<int>(o.x_px + rad + 6 * s), static_cast<int>(o.y_px)), ts, c, th / 2 + 1);
     }
 
     // header: time, rate, and each track's result so far
@@ -173,14 +191,14 @@ void draw_overlay(cv::Mat &img, const RunRecord &r, int64_t index)
     for (const auto &kv : latest) {
         y += static_cast<int>(26 * s);
         const JumpRecord &j = *kv.second;
-        label(img, "ball " + std::to_string(kv.first) + ": " + fmt("%.1f", j.running_height_m * 100.0) + " cm over " +
+        label(img, subject_name(r) + " " + std::to_string(kv.first) + ": " + fmt("%.1f", j.running_height_m * 100.0) + " cm over " +
                        std::to_string(j.running_n) + " flight(s)",
               cv::Point(static_cast<int>(10 * s), y), ts, track_color(static_cast<int>(kv.first)), th / 2 + 1);
     }
     for (const JumpRecord &j : r.jumps) {
         if (t >= j.t_takeoff_s && t <= j.t_land_s) {
             y += static_cast<int>(26 * s);
-            label(img, "in flight (ball " + std::to_string(j.track) + ", #" + std::to_string(j.index) + ")",
+            label(img, "in flight (" + subject_name(r) + " " + std::to_string(j.track) + ", #" + std::to_string(j.index) + ")",
                   cv::Point(static_cast<int>(10 * s), y), ts, j.accepted ? kAccepted : kRejected, th / 2 + 1);
         }
     }
@@ -400,7 +418,7 @@ bool write_plot(const RunRecord &r, const std::string &path, std::string &err)
         cv::Point2d apex = curve_at(j, j.t_apex_s);
         int ax = static_cast<int>(X(j.t_apex_s)) - 40, ay = static_cast<int>(Y(top, -apex.y)) - 34;
         ay = std::max(ay, top.box.y + 30);
-        std::string l1 = "ball " + std::to_string(j.track) + " #" + std::to_string(j.index) + " a=" + fmt("%.0f", j.a_px_s2);
+        std::string l1 = subject_name(r) + " " + std::to_string(j.track) + " #" + std::to_string(j.index) + " a=" + fmt("%.0f", j.a_px_s2);
         std::string l2 = j.accepted ? "d=" + fmt("%.1f", j.height_m * 100) + " cm" : j.reason;
         cv::putText(img, l1, {ax, ay}, cv::FONT_HERSHEY_SIMPLEX, 0.42, c, 1, cv::LINE_AA);
         cv::putText(img, l2, {ax, ay + 16}, cv::FONT_HERSHEY_SIMPLEX, 0.42, c, 1, cv::LINE_AA);
@@ -410,7 +428,7 @@ bool write_plot(const RunRecord &r, const std::string &path, std::string &err)
     cv::putText(img, title, {L, 28}, cv::FONT_HERSHEY_SIMPLEX, 0.65, text, 1, cv::LINE_AA);
     std::string sum;
     for (const SummaryRecord &s : r.summaries) {
-        sum += "ball " + std::to_string(s.track) + ": ";
+        sum += subject_name(r) + " " + std::to_string(s.track) + ": ";
         sum += std::isfinite(s.height_m) ? fmt("%.2f cm", s.height_m * 100) + " [" + fmt("%.2f", s.lo_m * 100) + ", " +
                                                fmt("%.2f", s.hi_m * 100) + "]"
                                          : std::string("no size");

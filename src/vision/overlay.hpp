@@ -48,6 +48,8 @@ struct RunRecord {
     std::vector<std::vector<ObsRecord>> frame_obs;  // detections of each frame
     std::vector<JumpRecord> jumps;
     std::vector<SummaryRecord> summaries;
+    bool person = false;                          // pose runs: a person's COM and skeleton
+    std::vector<std::vector<cv::Point3f>> frame_kp;  // pose: 33 keypoints (x, y, confidence) per frame, or none
 };
 
 // Fit each jump's drawing parabola to the observations inside its window.

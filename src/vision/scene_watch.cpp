@@ -1,0 +1,152 @@
+// scene_watch.cpp - per-flight and live warnings from recorded frame facts.
+#include "scene_watch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+extern "C" {
+#include "gravscale/gs_event.h"
+}
+
+namespace gs {
+
+namespace {
+constexpr double kKeepS = 6.0;  // longer than any flight plus the core's landing latency
+
+double median(std::vector<double> v)
+{
+    if (v.empty()) return NAN;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+}
+}  // namespace
+
+void SceneWatch::add(const SceneFrame &f)
+{
+    frames_.push_back(f);
+    while (!frames_.empty() && f.t_s - frames_.front().t_s > kKeepS) frames_.pop_front();
+}
+
+uint32_t SceneWatch::flight_warnings(double t0, double t1, double t_apex) const
+{
+    if (!std::isfinite(t0)) t0 = t_apex - 0.3;
+    if (!std::isfinite(t1)) t1 = t_apex + 0.3;
+    if (!std::isfinite(t0) || !std::isfinite(t1)) return 0;
+    const double a = t0 - cfg_.margin_s, b = t1 + cfg_.margin_s;
+    uint32_t w = 0;
+    bool first = true;
+    double x0 = 0, y0 = 0, moved = 0;
+    std::vector<double> sizes, before, after;
+    for (const SceneFrame &f : frames_) {
+        if (f.t_s >= t0 - 0.4 && f.t_s < t0 - 0.05 && std::isfinite(f.ground_y_px)) before.push_back(f.ground_y_px);
+        if (f.t_s > t1 + 0.05 && f.t_s <= t1 + 0.4 && std::isfinite(f.ground_y_px)) after.push_back(f.ground_y_px);
+        if (f.t_s < a || f.t_s > b) continue;
+        if (std::isfinite(f.size_px)) sizes.push_back(f.size_px);
+        if (f.present && f.at_border) w |= GS_WARN_LEFT_FRAME;
+        if (!f.cam_valid) {
+            w |= GS_WARN_CAMERA_MOVED;  // unknown camera motion is no static camera either
+            continue;
+        }
+        if (first) {
+            x0 = f.cam_dx_px;
+            y0 = f.cam_dy_px;
+            first = false;
+        }
+        moved = std::max(moved, std::hypot(f.cam_dx_px - x0, f.cam_dy_px - y0));
+    }
+    double size = median(sizes);
+    double thr = std::max(cfg_.cam_moved_min_px, std::isfinite(size) ? cfg_.cam_moved_rel * size : 0.0);
+    if (moved > thr) w |= GS_WARN_CAMERA_MOVED;
+    // the feet land on another row: the body moved in depth (or the camera tilted)
+    double gb = median(before), ga = median(after);
+    if (std::isfinite(gb) && std::isfinite(ga) && std::isfinite(size) && std::fabs(ga - gb) > cfg_.depth_rel * size)
+        w |= GS_WARN_OUT_OF_PLANE;
+    return w;
+}
+
+namespace {
+// the time the feet's row y(t) = y1 + v (t - t1) + a/2 (t - t1)^2 through the
+// airborne frames (t1, y1), (t2, y2) meets the ground row g, within [lo, hi]
+double ground_crossing(double t1, double y1, double t2, double y2, double a, double g, double lo, double hi)
+{
+    double dt = t2 - t1;
+    if (dt == 0.0 || !std::isfinite(dt)) return NAN;  // t2 after t1 (take-off) or before it (landing)
+    double v = (y2 - y1 - 0.5 * a * dt * dt) / dt;
+    double A = 0.5 * a, B = v, C = y1 - g;
+    double disc = B * B - 4.0 * A * C;
+    if (disc < 0.0 || A == 0.0) return NAN;
+    double best = NAN;
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+        double tau = (-B + sgn * std::sqrt(disc)) / (2.0 * A);
+        double t = t1 + tau;
+        if (t >= lo && t <= hi && (!std::isfinite(best) || std::fabs(t - t1) < std::fabs(best - t1))) best = t;
+    }
+    return best;
+}
+}  // namespace
+
+bool SceneWatch::feet_flight(double tc0, double tc1, double a, double *t0_s, double *t1_s) const
+{
+    if (!std::isfinite(tc0) || !std::isfinite(tc1) || !(a > 0.0)) return false;
+    std::vector<double> before, after, sizes;
+    std::vector<const SceneFrame *> fr;
+    for (const SceneFrame &f : frames_) {
+        if (!std::isfinite(f.feet_y_px)) continue;
+        if (f.t_s >= tc0 - 0.5 && f.t_s <= tc0 - 0.15) before.push_back(f.feet_y_px);
+        // the event comes a landing latency (~0.2 s) after the landing: what follows it so far
+        if (f.t_s >= tc1 && f.t_s <= tc1 + 0.5) after.push_back(f.feet_y_px);
+        if (f.t_s >= tc0 - 0.5 && f.t_s <= tc1 + 0.5) {
+            fr.push_back(&f);
+            if (std::isfinite(f.size_px)) sizes.push_back(f.size_px);
+        }
+    }
+    if (before.size() < 3 || after.size() < 2 || fr.size() < 6) return false;
+    double gb = median(before), ga = median(after), size = median(sizes);
+    if (!std::isfinite(size)) return false;
+    const double thr = 0.025 * size;  // toes this far above the ground are off it
+    const double mid = 0.5 * (tc0 + tc1);
+    // the airborne run around the middle of the core's flight
+    size_t m = 0;
+    for (size_t i = 0; i < fr.size(); i++)
+        if (std::fabs(fr[i]->t_s - mid) < std::fabs(fr[m]->t_s - mid)) m = i;
+    if (!(fr[m]->feet_y_px < std::min(gb, ga) - thr)) return false;
+    size_t i0 = m, i1 = m;
+    while (i0 > 0 && fr[i0 - 1]->feet_y_px < gb - thr) i0--;
+    while (i1 + 1 < fr.size() && fr[i1 + 1]->feet_y_px < ga - thr) i1++;
+    if (i0 == 0 || i1 + 1 >= fr.size() || i1 - i0 < 2) return false;  // the ground is not seen on both sides
+    // the first frames above the threshold may be a frame or two after the feet left (slow at first)
+    double t0 = ground_crossing(fr[i0]->t_s, fr[i0]->feet_y_px, fr[i0 + 1]->t_s, fr[i0 + 1]->feet_y_px, a, gb,
+                                fr[i0 >= 3 ? i0 - 3 : 0]->t_s, fr[i0]->t_s);
+    double t1 = ground_crossing(fr[i1]->t_s, fr[i1]->feet_y_px, fr[i1 - 1]->t_s, fr[i1 - 1]->feet_y_px, a, ga,
+                                fr[i1]->t_s, fr[std::min(fr.size() - 1, i1 + 3)]->t_s);
+    // no crossing in the gap (the feet were still slowing or the parabola misses): the gap's middle
+    if (!std::isfinite(t0)) t0 = 0.5 * (fr[i0 - 1]->t_s + fr[i0]->t_s);
+    if (!std::isfinite(t1)) t1 = 0.5 * (fr[i1]->t_s + fr[i1 + 1]->t_s);
+    *t0_s = t0;
+    *t1_s = t1;
+    return true;
+}
+
+uint32_t SceneWatch::onsets()
+{
+    if (frames_.empty()) return 0;
+    const SceneFrame &f = frames_.back();
+    uint32_t now = 0;
+    if (f.present && f.at_border) now |= GS_WARN_LEFT_FRAME;
+    // the camera moved over the last half second by more than the threshold
+    double size = std::isfinite(f.size_px) ? f.size_px : 0.0;
+    double thr = std::max(cfg_.cam_moved_min_px, cfg_.cam_moved_rel * size);
+    for (auto it = frames_.rbegin(); it != frames_.rend() && f.t_s - it->t_s <= 0.5; ++it) {
+        if (!it->cam_valid || !f.cam_valid ||
+            std::hypot(f.cam_dx_px - it->cam_dx_px, f.cam_dy_px - it->cam_dy_px) > thr) {
+            now |= GS_WARN_CAMERA_MOVED;
+            break;
+        }
+    }
+    uint32_t started = now & ~active_;
+    active_ = now;
+    return started;
+}
+
+}  // namespace gs

@@ -1,0 +1,189 @@
+// test_pose_video.cpp - `gravscale video --detector pose` end to end on real
+// clips with stated truth, and the scene watch (flight warnings, feet timing)
+// against synthetic truth.
+//  - jumpvision gym clip: one countermovement jump, 789 ms flight by a jump-test
+//    app, filmed handheld: the flight time within 2 frames and a camera_moved
+//    warning on the flight (the static-camera assumption is broken).
+//  - opencv_vtest: people walking far away: no jump, no height.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <vector>
+
+extern "C" {
+#include "gravscale/gs_event.h"
+#include "unity.h"
+}
+
+#include "scene_watch.hpp"
+
+#ifndef GS_SHARED_DIR
+#error "GS_SHARED_DIR must be defined"
+#endif
+
+void setUp(void) {}
+void tearDown(void) {}
+
+namespace {
+
+struct Run {
+    int code = -1;
+    std::string out;
+};
+
+Run run(const std::string &args)
+{
+    std::string cmd = std::string(GS_PROGRAM) + " video " + args + " 2>/tmp/gs_test_pose_video.err";
+    Run r;
+    FILE *p = popen(cmd.c_str(), "r");
+    TEST_ASSERT_NOT_NULL(p);
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+    int st = pclose(p);
+    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+    return r;
+}
+
+std::vector<std::string> lines_of(const std::string &out, const std::string &event)
+{
+    std::vector<std::string> v;
+    std::string pat = "\"event\":\"" + event + "\"";
+    size_t p = 0;
+    while (p < out.size()) {
+        size_t nl = out.find('\n', p);
+        if (nl == std::string::npos) nl = out.size();
+        std::string line = out.substr(p, nl - p);
+        if (line.find(pat) != std::string::npos) v.push_back(line);
+        p = nl + 1;
+    }
+    return v;
+}
+
+double num(const std::string &line, const char *key)
+{
+    std::string pat = std::string("\"") + key + "\":";
+    size_t k = line.find(pat);
+    if (k == std::string::npos) return NAN;
+    const char *s = line.c_str() + k + pat.size();
+    char *end;
+    double v = std::strtod(s, &end);
+    return end == s ? NAN : v;
+}
+
+bool exists(const std::string &p)
+{
+    struct stat st;
+    return stat(p.c_str(), &st) == 0;
+}
+
+}  // namespace
+
+static void test_gym_handheld_flight_time_and_warning(void)
+{
+    std::string clip = std::string(GS_SHARED_DIR) + "/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4";
+    if (!exists(clip)) TEST_IGNORE_MESSAGE("jumpvision_jumps is absent");
+    Run r = run("'" + clip + "' --detector pose");
+    TEST_ASSERT_EQUAL_INT(0, r.code);
+    auto jumps = lines_of(r.out, "jump");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, (int)jumps.size(), r.out.c_str());
+    const std::string &j = jumps[0];
+    double ft = num(j, "flight_time_s");
+    std::printf("gym clip: flight %.4f s (app 0.789 s), jump height %.3f m (app 0.763), %s\n", ft,
+                num(j, "jump_height_m"), j.substr(j.find("\"warnings\"")).c_str());
+    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(2.0 / 29.96, 0.789, ft, "flight time within 2 frames of the app's");
+    bool accepted = j.find("\"accepted\":true") != std::string::npos;
+    bool warned = j.find("\"camera_moved\"") != std::string::npos;
+    TEST_ASSERT_TRUE_MESSAGE(!accepted || warned, "a height from a moving camera carries camera_moved");
+    TEST_ASSERT_TRUE_MESSAGE(warned, "the handheld camera is noticed");
+    // guidance while it happens, and the visit with its result
+    TEST_ASSERT_TRUE(lines_of(r.out, "warning").size() >= 1);
+    auto ses = lines_of(r.out, "session");
+    TEST_ASSERT_EQUAL_INT(2, (int)ses.size());
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3, ft, num(ses[1], "best_flight_s"));
+}
+
+static void test_vtest_people_walking_report_nothing(void)
+{
+    std::string clip = std::string(GS_SHARED_DIR) + "/data/real/opencv_vtest/vtest_first15s_h264.mp4";
+    if (!exists(clip)) TEST_IGNORE_MESSAGE("opencv_vtest is absent");
+    Run r = run("'" + clip + "' --detector pose");
+    TEST_ASSERT_EQUAL_INT(0, r.code);
+    TEST_ASSERT_EQUAL_INT(0, (int)lines_of(r.out, "jump").size());
+    TEST_ASSERT_EQUAL_INT(0, (int)lines_of(r.out, "height").size());
+    auto sum = lines_of(r.out, "summary");
+    TEST_ASSERT_EQUAL_INT(1, (int)sum.size());
+    TEST_ASSERT_TRUE(sum[0].find("\"height_m\":null") != std::string::npos);
+}
+
+static void test_missing_models_is_a_clear_error(void)
+{
+    std::string clip = std::string(GS_SHARED_DIR) + "/data/real/opencv_vtest/vtest_first15s_h264.mp4";
+    Run r = run("'" + clip + "' --detector pose --models /nonexistent/models");
+    TEST_ASSERT_EQUAL_INT(2, r.code);
+    TEST_ASSERT_EQUAL_INT(0, (int)r.out.size());
+    FILE *f = std::fopen("/tmp/gs_test_pose_video.err", "r");
+    TEST_ASSERT_NOT_NULL(f);
+    char line[1024] = {0};
+    TEST_ASSERT_NOT_NULL(std::fgets(line, sizeof line, f));
+    std::fclose(f);
+    TEST_ASSERT_NOT_NULL_MESSAGE(std::strstr(line, "fetch_models.sh"), line);
+}
+
+// ---- the scene watch against synthetic truth ---------------------------------------
+
+// a jumper at 60 fps: toes on the ground row 900 px, off at t0, back at t1, flying
+// under a = 2000 px/s^2; the camera still or drifting; the body 600 px tall
+static void synth(gs::SceneWatch &w, double t0, double t1, double drift_px_s, double border_at)
+{
+    const double a = 2000.0, g = 900.0, v0 = 0.5 * a * (t1 - t0);
+    for (int i = 0; i <= 150; i++) {
+        double t = i / 60.0;
+        gs::SceneFrame f;
+        f.t_s = t;
+        f.present = true;
+        f.size_px = 600.0;
+        f.cam_dx_px = drift_px_s * t;
+        f.cam_dy_px = 0.0;
+        f.feet_y_px = (t > t0 && t < t1) ? g - v0 * (t - t0) + 0.5 * a * (t - t0) * (t - t0) : g;
+        f.ground_y_px = f.feet_y_px;
+        f.at_border = std::fabs(t - border_at) < 0.02;
+        w.add(f);
+    }
+}
+
+static void test_scene_watch_feet_timing_and_warnings(void)
+{
+    const double t0 = 0.7913, t1 = 1.2871;  // between frames
+    gs::SceneWatch still;
+    synth(still, t0, t1, 0.0, -1.0);
+    double a0, a1;
+    TEST_ASSERT_TRUE(still.feet_flight(t0 - 0.05, t1 + 0.04, 2000.0, &a0, &a1));
+    std::printf("feet timing: take-off %+.2f ms, landing %+.2f ms\n", (a0 - t0) * 1e3, (a1 - t1) * 1e3);
+    TEST_ASSERT_DOUBLE_WITHIN(0.002, t0, a0);
+    TEST_ASSERT_DOUBLE_WITHIN(0.002, t1, a1);
+    TEST_ASSERT_EQUAL_UINT32(0, still.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
+
+    gs::SceneWatch drift;  // 20 px/s: 10 px over the flight, above 1 % of 600 px
+    synth(drift, t0, t1, 20.0, 1.0);
+    uint32_t w = drift.flight_warnings(t0, t1, 0.5 * (t0 + t1));
+    TEST_ASSERT_TRUE(w & GS_WARN_CAMERA_MOVED);
+    TEST_ASSERT_TRUE(w & GS_WARN_LEFT_FRAME);
+    gs::SceneWatch slow;  // 5 px/s: 2.5 px over the flight, below 6 px
+    synth(slow, t0, t1, 5.0, -1.0);
+    TEST_ASSERT_EQUAL_UINT32(0, slow.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_scene_watch_feet_timing_and_warnings);
+    RUN_TEST(test_gym_handheld_flight_time_and_warning);
+    RUN_TEST(test_vtest_people_walking_report_nothing);
+    RUN_TEST(test_missing_models_is_a_clear_error);
+    return UNITY_END();
+}
