@@ -64,7 +64,21 @@ static const char *j_str(const char *s, char *out, size_t cap)
                     else if (h >= 'A' && h <= 'F') v |= (unsigned)(h - 'A' + 10);
                     else return NULL;
                 }
-                if (v > 0x7f) return NULL;
+                if (v > 0x7f) {
+                    /* U+0080..U+FFFF as UTF-8 (the emitter writes U+FFFD for bytes that are not UTF-8) */
+                    if (v >= 0xD800 && v <= 0xDFFF) return NULL;
+                    size_t k = v < 0x800 ? 2 : 3;
+                    if (n + k >= cap) return NULL;
+                    if (k == 2) {
+                        out[n++] = (char)(0xC0 | (v >> 6));
+                    } else {
+                        out[n++] = (char)(0xE0 | (v >> 12));
+                        out[n++] = (char)(0x80 | ((v >> 6) & 0x3F));
+                    }
+                    out[n++] = (char)(0x80 | (v & 0x3F));
+                    s += 5;
+                    continue;
+                }
                 c = (unsigned char)v;
                 s += 4;
                 break;
@@ -267,6 +281,13 @@ void test_json_exact_lines(void)
     e.u.start.config = "my \"gym\"\\cam\n\x01.cfg";
     check_exact(&e, "{\"event\":\"start\",\"version\":\"" GS_VERSION "\",\"config\":\"my \\\"gym\\\"\\\\cam"
                     "\\u000a\\u0001.cfg\",\"fps_source\":null,\"fps_origin\":null,\"layout\":null}\n");
+
+    /* JSON text is UTF-8: valid sequences pass, other bytes (a Latin-1 file name,
+     * overlong forms, surrogates, a cut sequence) become U+FFFD (found by tests/fuzz/fuzz_emit.c) */
+    e.u.start.config = "gr\xc3\xb6\xc3\x9f" "e \xe2\x82\xac \xf0\x9f\x98\x80 h\xf6he \xc0\xaf \xed\xa0\x80 \xf4\x90\x80\x80 \xe2\x82";
+    check_exact(&e, "{\"event\":\"start\",\"version\":\"" GS_VERSION "\",\"config\":\"gr\xc3\xb6\xc3\x9f" "e \xe2\x82\xac "
+                    "\xf0\x9f\x98\x80 h\\ufffdhe \\ufffd\\ufffd \\ufffd\\ufffd\\ufffd \\ufffd\\ufffd\\ufffd\\ufffd "
+                    "\\ufffd\\ufffd\",\"fps_source\":null,\"fps_origin\":null,\"layout\":null}\n");
 
     e = ev_jump();
     check_exact(&e, "{\"event\":\"jump\",\"track\":0,\"index\":3,\"t_takeoff_s\":12.3457,\"t_land_s\":12.8123,"

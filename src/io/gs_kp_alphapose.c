@@ -74,7 +74,7 @@ bool gs_kp_json_begin(gs_jlex *lex, const char *text, size_t len, const char *pa
         return false;
     }
     if (k != want) {
-        gs_kpread_fail(err, GS_KPR_EDATA, path, first->line, NULL, what);
+        gs_kpread_fail(err, GS_KPR_EDATA, path, first->line, NULL, "%s", what);
         return false;
     }
     return true;
