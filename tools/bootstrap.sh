@@ -10,8 +10,10 @@ BUILD_DIR=${BUILD_DIR:-build}
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 
-# OpenCV and libavformat for the video command (tests render clips with them)
-pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev)
+# OpenCV and libavformat for the video command (tests render clips with them);
+# clang with its sanitizer/libFuzzer runtime and llvm-symbolizer for tests/fuzz/run.sh
+pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev
+      clang libclang-rt-14-dev llvm-14)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

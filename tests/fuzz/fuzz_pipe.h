@@ -24,6 +24,7 @@ static void fz_pipe_event(void *ctx, const gs_event *ev)
     size_t n = gs_emit_json(ev, buf, sizeof buf);
     FZ_CHECK(n > 0); /* the app would lose this event */
     fz_check_json_line(buf, n);
+    if (getenv("FZ_PRINT") && ev->type != GS_EV_SAMPLE) fputs(buf, stderr); /* to look at one input */
     n = gs_emit_nmea(ev, buf, sizeof buf);
     if (ev->type == GS_EV_STATE || ev->type == GS_EV_SAMPLE || ev->type == GS_EV_FIT) FZ_CHECK(n == 0);
     else fz_check_nmea_line(buf, n);

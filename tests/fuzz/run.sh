@@ -4,7 +4,7 @@
 # (> 10 s) or out-of-memory fails the run. docs/fuzz.md says more.
 #   tests/fuzz/run.sh [SECONDS_PER_HARNESS [HARNESS...]]
 #   SECONDS defaults to $FUZZ_SECONDS or 20; harnesses: num config sink_config
-#   emit json_tok csv alphapose openpose (default: all).
+#   emit json_tok csv alphapose openpose core (default: all).
 #   FUZZ_OUT=dir (default build-fuzz/) keeps the objects, the grown corpora and
 #   crash_<harness>_* artifacts; a second run continues from the grown corpora.
 # Without clang or its fuzzer runtime it says so and exits 0 (tools/bootstrap.sh
@@ -12,7 +12,7 @@
 set -euo pipefail
 secs=${1:-${FUZZ_SECONDS:-20}}
 shift || true
-all=(num config sink_config emit json_tok csv alphapose openpose)
+all=(num config sink_config emit json_tok csv alphapose openpose core)
 if [ $# -gt 0 ]; then harnesses=("$@"); else harnesses=("${all[@]}"); fi
 top=$(cd "$(dirname "$0")/../.." && pwd)
 CC=${FUZZ_CC:-clang}
