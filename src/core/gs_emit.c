@@ -241,6 +241,13 @@ static void json_session(gs_w *w, const gs_ev_session *e)
     w_lit(w, "}\n");
 }
 
+size_t gs_emit_json_str(const char *s, char *buf, size_t cap)
+{
+    gs_w w = {buf, cap, 0, buf != NULL};
+    w_jstr(&w, s);
+    return w_finish(&w);
+}
+
 size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
 {
     gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};

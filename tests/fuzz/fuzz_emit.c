@@ -133,6 +133,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         static char ref[8192];
         size_t n = gs_emit((gs_format)fmt, &ev, ref, sizeof ref);
         if (type == 8) FZ_CHECK(n == 0 && ref[0] == '\0');
+        if (getenv("FZ_PRINT")) fprintf(stderr, "%zu: %s", n, ref); /* to look at one input */
         bool has_nmea = type <= GS_EV_SESSION;
         if (fmt == GS_FMT_JSON && type < 8) {
             FZ_CHECK(n > 0); /* any event fits a large buffer */
