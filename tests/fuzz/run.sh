@@ -62,6 +62,10 @@ for n in 0 -0 1.5 1e308 2.2250738585072011e-308 .5 5. 12345678901234567890123456
 done
 echo "fuzz: built ${#harnesses[@]} harnesses in $(( $(date +%s) - t_build )) s; ${secs} s each"
 
+# the reader harnesses write their inputs to temp files and folders: keep them here
+export TMPDIR="$out/tmp"
+rm -rf "$TMPDIR"
+mkdir -p "$TMPDIR"
 status=0
 for h in "${harnesses[@]}"; do
   mkdir -p "$out/corpus/$h" "$out/seeds/$h"
