@@ -64,7 +64,21 @@ static const char *j_str(const char *s, char *out, size_t cap)
                     else if (h >= 'A' && h <= 'F') v |= (unsigned)(h - 'A' + 10);
                     else return NULL;
                 }
-                if (v > 0x7f) return NULL;
+                if (v > 0x7f) {
+                    /* U+0080..U+FFFF as UTF-8 (the emitter writes U+FFFD for bytes that are not UTF-8) */
+                    if (v >= 0xD800 && v <= 0xDFFF) return NULL;
+                    size_t k = v < 0x800 ? 2 : 3;
+                    if (n + k >= cap) return NULL;
+                    if (k == 2) {
+                        out[n++] = (char)(0xC0 | (v >> 6));
+                    } else {
+                        out[n++] = (char)(0xE0 | (v >> 12));
+                        out[n++] = (char)(0x80 | ((v >> 6) & 0x3F));
+                    }
+                    out[n++] = (char)(0x80 | (v & 0x3F));
+                    s += 5;
+                    continue;
+                }
                 c = (unsigned char)v;
                 s += 4;
                 break;
@@ -267,6 +281,13 @@ void test_json_exact_lines(void)
     e.u.start.config = "my \"gym\"\\cam\n\x01.cfg";
     check_exact(&e, "{\"event\":\"start\",\"version\":\"" GS_VERSION "\",\"config\":\"my \\\"gym\\\"\\\\cam"
                     "\\u000a\\u0001.cfg\",\"fps_source\":null,\"fps_origin\":null,\"layout\":null}\n");
+
+    /* JSON text is UTF-8: valid sequences pass, other bytes (a Latin-1 file name,
+     * overlong forms, surrogates, a cut sequence) become U+FFFD (found by tests/fuzz/fuzz_emit.c) */
+    e.u.start.config = "gr\xc3\xb6\xc3\x9f" "e \xe2\x82\xac \xf0\x9f\x98\x80 h\xf6he \xc0\xaf \xed\xa0\x80 \xf4\x90\x80\x80 \xe2\x82";
+    check_exact(&e, "{\"event\":\"start\",\"version\":\"" GS_VERSION "\",\"config\":\"gr\xc3\xb6\xc3\x9f" "e \xe2\x82\xac "
+                    "\xf0\x9f\x98\x80 h\\ufffdhe \\ufffd\\ufffd \\ufffd\\ufffd\\ufffd \\ufffd\\ufffd\\ufffd\\ufffd "
+                    "\\ufffd\\ufffd\",\"fps_source\":null,\"fps_origin\":null,\"layout\":null}\n");
 
     e = ev_jump();
     check_exact(&e, "{\"event\":\"jump\",\"track\":0,\"index\":3,\"t_takeoff_s\":12.3457,\"t_land_s\":12.8123,"
@@ -641,6 +662,51 @@ void test_nmea_worst_case(void)
                                  buf, n - 4);
 }
 
+/* The widest lines: every number at its widest text, every warning, the
+ * longest reason. GS_EMIT_MAX must hold them (640 did not: fuzz_emit found a
+ * 744-byte jump line). */
+void test_json_widest_events_fit(void)
+{
+    const double F = -999999999999999.9; /* the widest fixed-notation value */
+    const double S = -1.23456789e-300;   /* the widest 6-significant-digit value */
+    char buf[GS_EMIT_MAX];
+    gs_event e;
+    memset(&e, 0, sizeof e);
+    e.type = GS_EV_JUMP;
+    gs_ev_jump *j = &e.u.jump;
+    j->track = j->index = j->n_samples = j->n_outliers = UINT32_MAX;
+    j->t_takeoff_s = j->t_land_s = j->flight_time_s = j->t_apex_s = F;
+    j->a_px_s2 = j->a_px_se_s2 = j->q_m_per_px = S;
+    j->g_dir_deg = j->size_px = j->height_m = j->height_se_m = j->jump_height_m = F;
+    j->takeoff_velocity_m_s = j->rms_px = F;
+    j->accepted = false;
+    j->reason = GS_REJ_IMPLAUSIBLE_A;
+    j->warnings = 0xFFu;
+    size_t n = gs_emit_json(&e, buf, sizeof buf);
+    TEST_ASSERT_EQUAL_UINT64(744, n);
+    jv v[32];
+    TEST_ASSERT_TRUE_MESSAGE(json_line(buf, v, 32) > 0, buf);
+
+    memset(&e, 0, sizeof e);
+    e.type = GS_EV_SESSION;
+    gs_ev_session *s = &e.u.session;
+    s->track = s->session = s->n_jumps = s->n_rejected = UINT32_MAX;
+    s->ended = true;
+    s->reason = "end_of_stream";
+    s->t_start_s = s->t_end_s = s->stature_m = s->ci95_lo_m = s->ci95_hi_m = F;
+    s->best_jump_m = s->mean_jump_m = s->best_flight_s = s->mean_flight_s = s->mean_takeoff_velocity_m_s = F;
+    n = gs_emit_json(&e, buf, sizeof buf);
+    TEST_ASSERT_TRUE(n > 0 && n < GS_EMIT_MAX);
+
+    /* a JSON string on its own, as the sinks' status lines use it */
+    TEST_ASSERT_EQUAL_UINT64(4, gs_emit_json_str(NULL, buf, sizeof buf));
+    TEST_ASSERT_EQUAL_STRING("null", buf);
+    TEST_ASSERT_EQUAL_UINT64(17, gs_emit_json_str("a\"\x01\xff", buf, sizeof buf));
+    TEST_ASSERT_EQUAL_STRING("\"a\\\"\\u0001\\ufffd\"", buf);
+    TEST_ASSERT_EQUAL_UINT64(0, gs_emit_json_str("a\"\x01\xff", buf, 17)); /* no room for the NUL */
+    TEST_ASSERT_EQUAL_STRING("", buf);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -649,5 +715,6 @@ int main(void)
     RUN_TEST(test_json_caps_canary);
     RUN_TEST(test_nmea_exact);
     RUN_TEST(test_nmea_worst_case);
+    RUN_TEST(test_json_widest_events_fit);
     return UNITY_END();
 }

@@ -87,6 +87,13 @@ static const csv_bad k_bad[] = {
      "not a number ('nan')"},
     {"inf text", "t,x,y,c\n0,inf,2,0.9\n", NAN, -1, GS_KPR_EDATA, 0, 2, "x", "not a number ('inf')"},
     {"overflow", "t,x,y,c\n0,1e999,2,0.9\n", NAN, -1, GS_KPR_EDATA, 0, 2, "x", "not a number"},
+    /* finite as double, inf as the float a keypoint is kept in */
+    {"float overflow", "t,x,y,c\n0,1,2,0.9\n0.1,1e39,2,0.9\n", NAN, -1, GS_KPR_EDATA, 1, 3, "x",
+     "'1e39' is beyond the float range"},
+    {"float overflow y", "t,x,y,c\n0,1,-3.5e38,0.9\n", NAN, -1, GS_KPR_EDATA, 0, 2, "y",
+     "'-3.5e38' is beyond the float range"},
+    {"float overflow size", "t,x,y,c,size\n0,1,2,0.9,1e300\n", NAN, -1, GS_KPR_EDATA, 0, 2, "size",
+     "beyond the float range"},
     {"spaces inside", "t,x,y,c\n0,1 2,2,0.9\n", NAN, -1, GS_KPR_EDATA, 0, 2, "x",
      "not a number ('1 2')"},
     {"two dots", "t,x,y,c\n0,1.2.3,2,0.9\n", NAN, -1, GS_KPR_EDATA, 0, 2, "x", "not a number"},
@@ -381,6 +388,8 @@ void test_csv_line_longer_than_block(void)
     size_t len = (1u << 20) + 100;
     char *text = malloc(len + 64);
     TEST_ASSERT_NOT_NULL(text);
+    if (!text)
+        return; /* unreachable (the assert jumps out); tells gcc -O2 + ASan it is not NULL */
     int h = snprintf(text, 64, "t,x,y,c\n0,");
     memset(text + h, '1', len);
     memcpy(text + h + len, ",2,0.9\n", 7);
@@ -519,6 +528,10 @@ static const json_bad k_ap_bad[] = {
      30, GS_KPR_EDATA, 2, "keypoints", "3 numbers, expected 51"},
     {"not a number", "[{\"image_id\": \"0.jpg\",\n \"keypoints\": [1, \"x\", 3]}]", 30, GS_KPR_EDATA, 1,
      "keypoints", "element 1 is not a number"},
+    {"float overflow", "[{\"image_id\": \"0.jpg\",\n \"keypoints\": [1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5,"
+                       " 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5, 1,2,0.5,"
+                       " 1,-1e39,0.5, 1,2,0.5]}]",
+     30, GS_KPR_EDATA, 1, "keypoints", "element 46 (-1e+39) is beyond the float range"},
     {"no image_id", "[\n\n{\"score\": 1.5, \"idx\": null}]", 30, GS_KPR_EDATA, 3, "image_id", "missing"},
     {"no digits", "[{\"image_id\": \"a.jpg\", \"keypoints\": []}]", 30, GS_KPR_EDATA, 1, "image_id",
      "no frame number"},
@@ -698,6 +711,19 @@ void test_openpose_bad_inputs(void)
     TEST_ASSERT_EQUAL_INT(GS_KPR_EDATA, read_all(dir, &o, fr, 4, &n, &err, NULL));
     TEST_ASSERT_EQUAL_UINT32(3, err.line);
     TEST_ASSERT_NOT_NULL(strstr(err.text, "invalid JSON"));
+
+    /* a coordinate finite as double but inf as float (BODY_25 keypoint 7, the left wrist) */
+    f = fopen(path, "wb");
+    TEST_ASSERT_NOT_NULL(f);
+    fputs("{\"people\":[\n{\"pose_keypoints_2d\":[", f);
+    for (int k = 0; k < 25; k++)
+        fprintf(f, "%s%s,20,0.5", k ? "," : "", k == 7 ? "4e38" : "10");
+    fputs("]}\n]}\n", f);
+    fclose(f);
+    TEST_ASSERT_EQUAL_INT(GS_KPR_EDATA, read_all(dir, &o, fr, 4, &n, &err, NULL));
+    TEST_ASSERT_EQUAL_UINT32(2, err.line);
+    TEST_ASSERT_EQUAL_STRING("pose_keypoints_2d", err.field);
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err.text, "keypoint 7 (4e+38, 20) is beyond the float range"), err.text);
 }
 
 /* ---- the JSON tokenizer ------------------------------------------------- */

@@ -348,6 +348,32 @@ void test_stdout_sink_on_a_full_pipe_and_a_closed_one(void)
     TEST_ASSERT_EQUAL_INT(0, close(p[1]));
 }
 
+/* a name that is not UTF-8 or holds control bytes still gives valid JSON
+ * (found by tests/fuzz/fuzz_sink_config.c: host = "loc\x9alhost") */
+void test_status_json_escapes_any_name(void)
+{
+    int fd = open("/dev/null", O_WRONLY);
+    TEST_ASSERT_TRUE(fd >= 0);
+    gs_sinkset set;
+    gs_sinkset_init(&set);
+    gs_sink s;
+    char err[160];
+    TEST_ASSERT_EQUAL_INT(0, gs_sink_fd_open(&s, fd, "loc\x9alhost \"a\\b\"\t\xc3\xa9", err, sizeof err));
+    TEST_ASSERT_EQUAL_INT(0, gs_sinkset_add(&set, &s));
+    char st[1024];
+    size_t n = gs_sinkset_status_json(&set, st, sizeof st);
+    TEST_ASSERT_TRUE(n > 0);
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(st, "\"target\":\"loc\\ufffdlhost \\\"a\\\\b\\\"\\u0009\xc3\xa9\",\"state\""), st);
+    /* every cap up to the full size: "" and 0, never a cut line */
+    for (size_t cap = 1; cap <= n; cap++) {
+        char small[1024];
+        TEST_ASSERT_EQUAL_UINT(0, gs_sinkset_status_json(&set, small, cap));
+        TEST_ASSERT_EQUAL_STRING("", small);
+    }
+    gs_sinkset_close(&set);
+    close(fd);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -357,5 +383,6 @@ int main(void)
     RUN_TEST(test_sinkset_from_profile_fans_out_the_same_bytes);
     RUN_TEST(test_open_failure_names_the_sink_and_leaves_nothing_open);
     RUN_TEST(test_stdout_sink_on_a_full_pipe_and_a_closed_one);
+    RUN_TEST(test_status_json_escapes_any_name);
     return UNITY_END();
 }

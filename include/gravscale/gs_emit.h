@@ -24,7 +24,17 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap);
 /* Dispatch on the format. */
 size_t gs_emit(gs_format fmt, const gs_event *ev, char *buf, size_t cap);
 
-/* Enough for any event in either format. */
-#define GS_EMIT_MAX 640
+/* A JSON string literal of s as the emitter writes strings (quotes included,
+ * NUL-terminated): '"' and '\\' escaped, control bytes as \u00XX, bytes that
+ * are not UTF-8 as \ufffd; NULL -> null. For other JSON writers at the edge
+ * (sink status lines). Returns the length, 0 when cap is too small (buf ""). */
+size_t gs_emit_json_str(const char *s, char *buf, size_t cap);
+
+/* Enough for any event in either format when its strings are the core's own
+ * short names (a start event's caller strings add their length). The widest
+ * line is a jump with every number at its widest (-999999999999999.8750,
+ * -1.23457e-300, 4294967295) and every warning: 744 bytes + NUL, measured by
+ * tests/test_emit.c; 640 was too small for it (found by tests/fuzz/fuzz_emit.c). */
+#define GS_EMIT_MAX 768
 
 #endif

@@ -41,7 +41,30 @@ static void w_u32(gs_w *w, uint32_t v)
     w_raw(w, t + n, sizeof t - n);
 }
 
-/* a JSON string; NULL -> null. Control bytes become \u00XX; other bytes pass (UTF-8 stays UTF-8). */
+/* Length of the valid UTF-8 sequence at s (RFC 3629: no overlong forms, no
+ * surrogates, at most U+10FFFF), 0 when invalid. s is NUL-terminated and a NUL
+ * fails the continuation test, so nothing past the string is read. */
+static size_t utf8_len(const unsigned char *s)
+{
+    unsigned c = s[0];
+    size_t n;
+    uint32_t min, cp;
+    if (c < 0x80u) return 1;
+    if (c >= 0xC2u && c <= 0xDFu) n = 2, min = 0x80u, cp = c & 0x1Fu;
+    else if (c >= 0xE0u && c <= 0xEFu) n = 3, min = 0x800u, cp = c & 0x0Fu;
+    else if (c >= 0xF0u && c <= 0xF4u) n = 4, min = 0x10000u, cp = c & 0x07u;
+    else return 0;
+    for (size_t i = 1; i < n; i++) {
+        if ((s[i] & 0xC0u) != 0x80u) return 0;
+        cp = cp << 6 | (s[i] & 0x3Fu);
+    }
+    if (cp < min || cp > 0x10FFFFu || (cp >= 0xD800u && cp <= 0xDFFFu)) return 0;
+    return n;
+}
+
+/* a JSON string; NULL -> null. Control bytes become \u00XX; valid UTF-8 passes;
+ * a byte that is not UTF-8 (a Latin-1 file name) becomes \ufffd, because JSON
+ * text must be UTF-8 (RFC 8259 8.1) and readers reject the whole line otherwise. */
 static void w_jstr(gs_w *w, const char *s)
 {
     static const char hex[] = "0123456789abcdef";
@@ -58,8 +81,16 @@ static void w_jstr(gs_w *w, const char *s)
         } else if (c < 0x20u) {
             char e[6] = {'\\', 'u', '0', '0', hex[c >> 4], hex[c & 15u]};
             w_raw(w, e, 6);
-        } else {
+        } else if (c < 0x80u) {
             w_raw(w, (const char *)&c, 1);
+        } else {
+            size_t n = utf8_len((const unsigned char *)s);
+            if (n) {
+                w_raw(w, s, n);
+                s += n - 1;
+            } else {
+                w_lit(w, "\\ufffd");
+            }
         }
     }
     w_raw(w, "\"", 1);
@@ -216,6 +247,13 @@ static void json_session(gs_w *w, const gs_ev_session *e)
     w_lit(w, ",\"mean_takeoff_velocity_m_s\":");
     w_fixed(w, e->mean_takeoff_velocity_m_s, 3);
     w_lit(w, "}\n");
+}
+
+size_t gs_emit_json_str(const char *s, char *buf, size_t cap)
+{
+    gs_w w = {buf, cap, 0, buf != NULL};
+    w_jstr(&w, s);
+    return w_finish(&w);
 }
 
 size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)

@@ -3,6 +3,7 @@
  * held in memory because frames may come in any order. Also the JSON helpers
  * the OpenPose reader shares. */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -74,7 +75,7 @@ bool gs_kp_json_begin(gs_jlex *lex, const char *text, size_t len, const char *pa
         return false;
     }
     if (k != want) {
-        gs_kpread_fail(err, GS_KPR_EDATA, path, first->line, NULL, what);
+        gs_kpread_fail(err, GS_KPR_EDATA, path, first->line, NULL, "%s", what);
         return false;
     }
     return true;
@@ -213,6 +214,15 @@ static bool parse_person(gs_jlex *lex, const gs_jtok *obj, const char *path, gs_
                 gs_kpread_fail(err, GS_KPR_EDATA, path, obj->line, "keypoints",
                                "%zu numbers, expected 51 (COCO-17 x, y, score)", n);
                 return false;
+            }
+            for (int j = 0; j < 34; j++) {
+                double xy = vals[3 * (j / 2) + j % 2];
+                if (!(fabs(xy) <= FLT_MAX)) { /* kept as float: it would become inf */
+                    gs_kpread_fail(err, GS_KPR_EDATA, path, obj->line, "keypoints",
+                                   "element %d (%.6g) is beyond the float range of a pixel coordinate",
+                                   3 * (j / 2) + j % 2, xy);
+                    return false;
+                }
             }
             for (int j = 0; j < 17; j++) {
                 double c = vals[3 * j + 2];

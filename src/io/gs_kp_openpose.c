@@ -3,6 +3,7 @@
  * in BODY_25 (75 numbers) or COCO-18 (54), mapped to COCO-17. */
 #include <dirent.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,6 +73,12 @@ static bool parse_person(gs_jlex *lex, const gs_jtok *obj, const char *path, uin
                 const double *src = &vals[3 * map[j]];
                 double c = src[2];
                 gs_kp *kp = &p.kp[j];
+                if (!(fabs(src[0]) <= FLT_MAX && fabs(src[1]) <= FLT_MAX)) { /* kept as float: it would become inf */
+                    gs_kpread_fail(err, GS_KPR_EDATA, path, obj->line, "pose_keypoints_2d",
+                                   "keypoint %d (%.6g, %.6g) is beyond the float range of a pixel coordinate",
+                                   (int)map[j], src[0], src[1]);
+                    return false;
+                }
                 kp->c = (float)(c < 0.0 ? 0.0 : c > 1.0 ? 1.0 : c);
                 /* OpenPose writes 0,0,0 for a keypoint it did not find */
                 kp->x_px = kp->c > 0.0f ? (float)src[0] : NAN;

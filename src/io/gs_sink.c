@@ -251,20 +251,13 @@ static bool put(char *buf, size_t cap, size_t *n, const char *fmt, ...)
     return true;
 }
 
-/* a JSON string body: quotes, backslashes and control characters escaped */
+/* the emitter's string rules, so a device or host name that is not UTF-8
+ * (found by tests/fuzz/fuzz_sink_config.c) still gives a valid JSON line */
 static bool put_json_str(char *buf, size_t cap, size_t *n, const char *s)
 {
-    if (!put(buf, cap, n, "\""))
-        return false;
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        bool ok = (c == '"' || c == '\\') ? put(buf, cap, n, "\\%c", c)
-                  : c < 0x20              ? put(buf, cap, n, "\\u%04x", c)
-                                          : put(buf, cap, n, "%c", c);
-        if (!ok)
-            return false;
-    }
-    return put(buf, cap, n, "\"");
+    size_t m = *n < cap ? gs_emit_json_str(s, buf + *n, cap - *n) : 0;
+    *n += m;
+    return m > 0;
 }
 
 size_t gs_sinkset_status_json(const gs_sinkset *set, char *buf, size_t cap)
