@@ -85,7 +85,18 @@ public:
         size_ = cv::Size(static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_WIDTH)),
                          static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_HEIGHT)));
         drops_.reset(fps_ > 0.0 ? 1.0 / fps_ : 0.0);
-        time_origin_ = "position";
+        by_position_ = cfg.gst_time == "position";
+        if (!by_position_ && cfg.gst_time != "count") {
+            err = "gstreamer: timestamps must be count or position, not '" + cfg.gst_time + "'";
+            kind = CaptureError::usage;
+            return false;
+        }
+        if (!by_position_ && !(fps_ > 0.0)) {
+            err = "gstreamer: the pipeline gives no frame rate: set fps in the caps or use timestamps = position";
+            kind = CaptureError::usage;
+            return false;
+        }
+        time_origin_ = by_position_ ? "position" : "count";
         char line[128];
         std::snprintf(line, sizeof line, "gstreamer: %dx%d %.3g fps: ", size_.width, size_.height, fps_);
         desc_ = line + pipeline_;
@@ -99,25 +110,20 @@ public:
         if (!cap_.isOpened()) return ReadResult::end;
         cv::utils::logging::LogLevel old = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
         bool ok = cap_.read(f.bgr);
-        double pos_ms = ok ? cap_.get(cv::CAP_PROP_POS_MSEC) : NAN;
+        double pos_ms = ok && by_position_ ? cap_.get(cv::CAP_PROP_POS_MSEC) : NAN;
         cv::utils::logging::setLogLevel(old);
         if (!ok || f.bgr.empty()) {
             cap_.release();
             return ReadResult::end;
         }
-        // The pipeline position when the frame reached appsink (OpenCV 4.6 has
-        // no buffer PTS): ~1 ms jitter. When it does not advance (a pipeline
-        // without a clock), frame count / fps is used from then on.
-        double t = pos_ms * 1e-3;
-        if (!std::isfinite(t) || (frames_ > 0 && !(t > last_t_)) || count_time_) {
-            if (fps_ > 0.0) {
-                if (!count_time_) count_base_ = frames_ > 0 ? last_t_ - frames_ / fps_ : 0.0;
-                count_time_ = true;
-                time_origin_ = "count";
-                t = count_base_ + static_cast<double>(frames_) / fps_;
-            } else {
-                t = frames_ > 0 ? last_t_ + 1e-3 : 0.0;
-            }
+        double t;
+        if (by_position_) {
+            // the position when read, kept increasing (a repeated value gets +1 us)
+            t = pos_ms * 1e-3;
+            if (!std::isfinite(t)) t = last_t_;
+            if (frames_ > 0 && !(t > last_t_)) t = last_t_ + 1e-6;
+        } else {
+            t = static_cast<double>(frames_) / (fps_ > 0.0 ? fps_ : 30.0);
         }
         last_t_ = t;
         deliver(f, t, -1);
@@ -127,8 +133,8 @@ public:
 private:
     std::string pipeline_;
     cv::VideoCapture cap_;
-    double last_t_ = 0.0, count_base_ = 0.0;
-    bool count_time_ = false;
+    double last_t_ = 0.0;
+    bool by_position_ = false;
 };
 
 // ---- a file (reuses FrameSource: repaired stream times) ---------------------------

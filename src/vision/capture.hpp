@@ -53,6 +53,11 @@ struct CaptureConfig {
     std::string pixel_format = "auto";  // auto | mjpeg | yuyv (V4L2, libcamera)
     unsigned buffers = 4;           // V4L2 mmap buffers / libcamera requests
     bool realtime = true;           // file: pace frames at their stream times
+    // gstreamer: "count" = frame count / fps (exact while no frame is lost; a
+    // lost frame is invisible), "position" = the pipeline position when the
+    // frame is read (OpenCV 4.6 exposes no buffer PTS; frames queued in
+    // appsink under load get nearly equal times)
+    std::string gst_time = "count";
 };
 
 enum class ReadResult { frame, timeout, end, error };

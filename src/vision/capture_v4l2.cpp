@@ -136,8 +136,9 @@ bool V4l2Capture::negotiate(const CaptureConfig &cfg, std::string &err, CaptureE
         }
     }
     if (!got) {
-        err = "v4l2 " + path_ + ": the device offers neither " +
-              (cfg.pixel_format == "auto" ? std::string("MJPEG nor YUYV") : cfg.pixel_format) +
+        err = "v4l2 " + path_ + ": " +
+              (cfg.pixel_format == "auto" ? std::string("the device offers neither MJPEG nor YUYV")
+                                          : "the device does not offer " + std::string(cfg.pixel_format == "mjpeg" ? "MJPEG" : "YUYV")) +
               (last_errno ? " (VIDIOC_S_FMT: " + errtext(last_errno) + ")" : "");
         kind = CaptureError::device;
         return false;
@@ -299,7 +300,12 @@ ReadResult V4l2Capture::read(CaptureFrame &f, int timeout_ms)
     const double t = static_cast<double>(b.timestamp.tv_sec) + 1e-6 * static_cast<double>(b.timestamp.tv_usec);
     monotonic_ = (b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
     time_origin_ = monotonic_ ? "driver" : "driver_unknown_clock";
-    if (io_->ioctl(fd_, VIDIOC_QBUF, &b) != 0) return fail("VIDIOC_QBUF", errno);
+    if (io_->ioctl(fd_, VIDIOC_QBUF, &b) != 0) {
+        // the device went away after giving this frame: deliver it, fail on the next read
+        int e = errno;
+        ReadResult rr = fail(e == ENODEV ? "the device went away (VIDIOC_QBUF)" : "VIDIOC_QBUF", e);
+        if (!ok) return rr;
+    }
     if (!ok) {
         corrupt_++;  // a broken JPEG or a short buffer: skipped, counted
         return ReadResult::timeout;
