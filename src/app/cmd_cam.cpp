@@ -23,6 +23,7 @@
 extern "C" {
 #include "gravscale/gravscale.h"
 #include "gs_kpread.h"
+#include "gs_profile.h"
 #include "gs_sink_config.h"
 }
 
@@ -120,6 +121,10 @@ gs_status cam_config_set(void *ctx, const char *key, size_t kl, const char *v, s
             c.cap.realtime = false;
         else
             return set_msg(msg, cap, "expected yes or no", GS_EINVAL);
+    } else if (k == "gst_timestamps") {
+        if (!is_word(v, vl, "count") && !is_word(v, vl, "position"))
+            return set_msg(msg, cap, "expected count or position", GS_EINVAL);
+        c.cap.gst_time = val;
     } else if (k == "drain_s") {
         if (!gs_num_parse(v, vl, &d)) return set_msg(msg, cap, "expected a number", GS_EINVAL);
         if (!(d >= 0 && d <= 60)) return set_msg(msg, cap, "out of range 0 .. 60", GS_ERANGE);
@@ -254,6 +259,12 @@ gs_status parse_profile(const std::string &text, Profile &p, bool small_object, 
     gs_cfg_section sink_sec[GS_SINKS_CONFIG_SECTIONS];
     size_t ns = gs_sinks_config_sections(&p.sinks, sink_sec, GS_SINKS_CONFIG_SECTIONS);
     sec.insert(sec.end(), sink_sec, sink_sec + ns);
+    // sections of the profile no layer here reads (a detector not built in) are skipped
+    std::vector<const char *> own;
+    for (const gs_cfg_section &x : sec) own.push_back(x.name);
+    gs_cfg_section foreign[GS_PROFILE_SECTIONS];
+    size_t nf = gs_profile_foreign_sections(own.data(), own.size(), foreign, GS_PROFILE_SECTIONS);
+    sec.insert(sec.end(), foreign, foreign + nf);
     std::memset(&e, 0, sizeof e);
     gs_status st = gs_cfg_parse(text.data(), text.size(), sec.data(), sec.size(), &e);
     if (st != GS_OK) return st;

@@ -28,6 +28,7 @@
 extern "C" {
 #include "gravscale/gravscale.h"
 #include "gs_out.h"
+#include "gs_profile.h"
 }
 
 extern "C" int gs_cmd_video(int argc, char **argv);
@@ -173,10 +174,14 @@ int load_config(const std::string &path, gs_core_config &cfg, gs::BallConfig &ba
                      static_cast<unsigned>(kConfigMaxBytes));
         return EXIT_USAGE;
     }
-    const gs_cfg_section sections[] = {{"core", gs_core_config_set, &cfg}, {"ball", gs::ball_config_set, &ball}};
+    // [core] and [ball]; the other sections of a profile belong to cam (gs_profile.h)
+    gs_cfg_section sections[2 + GS_PROFILE_SECTIONS] = {{"core", gs_core_config_set, &cfg},
+                                                        {"ball", gs::ball_config_set, &ball}};
+    static const char *const own[] = {"core", "ball"};
+    size_t n_sections = 2 + gs_profile_foreign_sections(own, 2, sections + 2, GS_PROFILE_SECTIONS);
     gs_cfg_error e;
     std::memset(&e, 0, sizeof e);
-    gs_status st = gs_cfg_parse(text.data(), n, sections, sizeof sections / sizeof sections[0], &e);
+    gs_status st = gs_cfg_parse(text.data(), n, sections, n_sections, &e);
     if (st == GS_OK) {
         std::memset(&e, 0, sizeof e);
         st = gs_core_config_check(&cfg, &e);
