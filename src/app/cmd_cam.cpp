@@ -139,7 +139,7 @@ struct Options {
     std::string config, backend, device, pixel_format, detector;
     int width = 0, height = 0;
     double fps = 0.0, status_interval_s = -1.0, drain_s = -1.0;
-    bool fast = false, out_format_set = false;
+    bool fast = false, out_format_set = false, check = false;
     gs_format out_format = GS_FMT_JSON;
 };
 
@@ -170,6 +170,10 @@ int parse_args(int argc, char **argv, Options &o)
         }
         if (a == "--as-fast-as-possible") {
             o.fast = true;
+            continue;
+        }
+        if (a == "--check") {
+            o.check = true;
             continue;
         }
         size_t eq = a.find('=');
@@ -537,6 +541,19 @@ int run(const Options &o)
     int rc = load_profile(o, prof);
     if (rc != EXIT_OK) return rc;
     const CamConfig &cc = prof.cam;
+    if (o.check) {
+        size_t n_sinks = 0;
+        const gs_sink_switch *sw[] = {&prof.sinks.file_sw, &prof.sinks.serial_sw, &prof.sinks.tcp_sw,
+                                      &prof.sinks.tcp_client_sw, &prof.sinks.udp_sw};
+        for (const gs_sink_switch *x : sw) n_sinks += gs_sinks_config_on(x, false);
+        n_sinks += gs_sinks_config_on(&prof.sinks.stdout_sw, true);
+        std::printf("%s: backend %s, device '%s', %dx%d, %g fps, pixel format %s, detector %s, format %s, "
+                    "%zu sink(s), status every %g s\n",
+                    o.config.c_str(), cc.cap.backend.c_str(), cc.cap.device.c_str(), cc.cap.width, cc.cap.height,
+                    cc.cap.fps, cc.cap.pixel_format.c_str(), cc.detector.c_str(), gs_format_name(prof.core.format),
+                    n_sinks, prof.sinks.status_interval_s);
+        return std::fflush(stdout) == 0 ? EXIT_OK : EXIT_IO;
+    }
     install_signals();
 
     // the source
