@@ -305,7 +305,9 @@ int load_profile(const Options &o, Profile &p)
         return EXIT_USAGE;
     }
     const std::string det = o.detector.empty() ? p.cam.detector : o.detector;
-    if (gs::detector_is_small_object(det) && parse_profile(text, p, true, e) != GS_OK) {
+    const std::string backend = o.backend.empty() ? p.cam.cap.backend : o.backend;
+    // keypoints come without a detector: the size range stays a person's
+    if (backend != "keypoints" && gs::detector_is_small_object(det) && parse_profile(text, p, true, e) != GS_OK) {
         print_cfg_error(o.config, e);
         return EXIT_USAGE;
     }
