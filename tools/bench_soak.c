@@ -212,7 +212,8 @@ int main(int argc, char **argv)
     static long rss_at[MAX_SAMPLES];
     static double t_at[MAX_SAMPLES];
     size_t n_rss = 0;
-    double t_started = -1.0;
+    double t_started = -1.0, t_summary = -1.0;
+    size_t scanned = 0;
     long rss_early = -1, rss_mid = -1, rss_last = -1, hwm = -1;
     double t_early = 0;
     int status = 0;
@@ -246,6 +247,8 @@ int main(int argc, char **argv)
         if (now >= next_sample) {
             long r = rss_kb(pid, "VmRSS:"), h = rss_kb(pid, "VmHWM:");
             if (t_started < 0 && tlen > 0) t_started = now - t0;  /* the start line: set-up done */
+            if (t_summary < 0 && count(tcp + scanned, tlen - scanned, "{\"event\":\"summary\"")) t_summary = now - t0; /* stream over */
+            scanned = tlen > 32 ? tlen - 32 : 0;
             if (r > 0 && n_rss < MAX_SAMPLES) {
                 rss_last = r;
                 hwm = h;
@@ -258,19 +261,24 @@ int main(int argc, char **argv)
         if (w == pid) done = true;
     }
     double wall = now_s() - t0;
+    const double stream_end = t_summary >= 0 ? t_summary : wall;
     /* "before": the first sample after a tenth of the run (buffers warmed up, the
      * stream under way); "after": the last sample before the daemon exited */
     for (size_t i = 0; i < n_rss; i++)
-        if (t_started >= 0 && t_at[i] >= t_started && t_at[i] >= 0.1 * wall) {
+        if (t_started >= 0 && t_at[i] >= t_started + 0.1 * (stream_end - t_started)) {
             rss_early = rss_at[i];
             t_early = t_at[i];
             break;
         }
     for (size_t i = 0; i < n_rss; i++)
-        if (t_at[i] >= 0.5 * wall) {
+        if (t_started >= 0 && t_at[i] >= t_started + 0.5 * (stream_end - t_started)) {
             rss_mid = rss_at[i];
             break;
         }
+    /* "after": the last sample before the summary arrived (the end of the
+     * stream; library teardown at exit is not the daemon's steady state) */
+    for (size_t i = 0; i < n_rss; i++)
+        if (t_summary < 0 || t_at[i] < t_summary) rss_last = rss_at[i];
     if (sock >= 0) {  /* what is left in the socket */
         ssize_t n;
         if (cap - tlen < 65536) tcp = realloc(tcp, cap *= 2);
@@ -322,7 +330,7 @@ int main(int argc, char **argv)
     printf("bench_soak: daemon exit %d after %.1f s wall (%.0f frames/s, %.1fx real time)\n", rc, wall, frames / wall,
            frames / fps / wall);
     printf("bench_soak: CPU %.2f s user+sys = %.2f us per frame\n", cpu, 1e6 * cpu / (double)frames);
-    printf("bench_soak: RSS %ld kB at %.1f s (10 %% of the run), %ld kB at half time, %ld kB at the end (%+ld kB), peak %ld kB\n",
+    printf("bench_soak: RSS %ld kB at %.1f s (10 %% of the stream), %ld kB at half time, %ld kB at its end (%+ld kB), peak %ld kB\n",
            rss_early, t_early, rss_mid, rss_last, rss_last - rss_early, hwm);
     printf("bench_soak: flights: truth %ld, emitted %zu (file sink) / %zu (tcp_client sink), accepted %zu; %zu summary, %zu status lines; "
            "file %zu bytes, TCP %zu bytes\n",
