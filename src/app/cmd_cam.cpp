@@ -510,7 +510,7 @@ void write_status(Daemon &d, const Stats &s, double t_s, double fps)
     if (d.fmt == GS_FMT_NMEA) {
         char body[96];
         int b = std::snprintf(body, sizeof body, "GSSTS,%lld,%s,%llu,%s", static_cast<long long>(s.frames),
-                              std::isfinite(fps) ? fps_txt : "", static_cast<unsigned long long>(s.dropped), s.state);
+                              std::isfinite(fps) && fps < 1e6 ? fps_txt : "", static_cast<unsigned long long>(s.dropped), s.state);
         n = std::snprintf(line, sizeof line, "$%s*%02X\r\n", body, nmea_checksum(body, static_cast<size_t>(b)));
     } else {
         static char sinks[8192];
