@@ -491,6 +491,64 @@ static void test_shipped_profiles_parse(void)
     }
 }
 
+// NMEA: every line a checksummed sentence of at most 82 characters, the
+// status as $GSSTS, the last one `stopped` with every frame counted.
+static void test_nmea_status_sentences(void)
+{
+    std::string cfg = tmp("nmea.cfg");
+    write_text(cfg, std::string("[cam]\nbackend = keypoints\ndevice = ") + GS_SOURCE_DIR +
+                        "/tests/data/sample_jumps.csv\nrealtime = no\n[core]\nformat = nmea\n[status]\ninterval_s = 0.001\n");
+    Daemon d;
+    d.start({"--config", cfg}, tmp("nmea.out"));
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, d.wait_exit(20.0), d.err.c_str());
+    std::string out = slurp(tmp("nmea.out"));
+    std::vector<std::string> sts;
+    size_t p = 0;
+    int n = 0;
+    while (p < out.size()) {
+        size_t e = out.find("\r\n", p);
+        TEST_ASSERT_TRUE_MESSAGE(e != std::string::npos, out.c_str());
+        std::string line = out.substr(p, e - p);
+        TEST_ASSERT_TRUE_MESSAGE(line.size() + 2 <= 82 && line[0] == '$', line.c_str());
+        size_t star = line.rfind('*');
+        TEST_ASSERT_TRUE(star != std::string::npos && star + 3 == line.size());
+        unsigned x = 0;
+        for (size_t i = 1; i < star; i++) x ^= static_cast<unsigned char>(line[i]);
+        TEST_ASSERT_EQUAL_UINT_MESSAGE(x, std::strtoul(line.substr(star + 1).c_str(), nullptr, 16), line.c_str());
+        if (line.compare(0, 7, "$GSSTS,") == 0) sts.push_back(line);
+        p = e + 2;
+        n++;
+    }
+    TEST_ASSERT_TRUE(n > 5);
+    TEST_ASSERT_EQUAL_INT(0, static_cast<int>(out.find("$GSSTA,")));
+    TEST_ASSERT_TRUE(out.find("$GSSUM,") != std::string::npos);
+    TEST_ASSERT_TRUE(!sts.empty());
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, static_cast<int>(sts.back().find("$GSSTS,363,")), sts.back().c_str());  // 363 rows
+    TEST_ASSERT_TRUE_MESSAGE(sts.back().find(",0,stopped*") != std::string::npos, sts.back().c_str());
+}
+
+// The source fails mid-run (a bad row in a keypoint CSV stands in for a
+// camera that goes away): the events so far are flushed, summary included,
+// one error line names the place, exit 1.
+static void test_source_failure_mid_run_flushes_and_exits_1(void)
+{
+    std::string csv = tmp("broken.csv"), cfg = tmp("broken.cfg");
+    std::string text = slurp(std::string(GS_SOURCE_DIR) + "/tests/data/sample_jumps.csv");
+    TEST_ASSERT_TRUE(text.size() > 1000);
+    const int rows = count_lines(text);
+    write_text(csv, text + "99.0,not-a-number\n");
+    write_text(cfg, "[cam]\nbackend = keypoints\ndevice = " + csv + "\nrealtime = no\n[status]\ninterval_s = 0\n");
+    Daemon d;
+    d.start({"--config", cfg}, tmp("broken.out"));
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, d.wait_exit(20.0), d.err.c_str());
+    TEST_ASSERT_TRUE_MESSAGE(d.err.find("gravscale: " + csv + ":" + std::to_string(rows + 1) + ":") == 0, d.err.c_str());
+    std::string out = slurp(tmp("broken.out"));
+    auto sum = lines_of(out, "summary");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, static_cast<int>(sum.size()), out.c_str());
+    TEST_ASSERT_EQUAL_INT(3, static_cast<int>(num(sum[0], "n_jumps")));
+    TEST_ASSERT_EQUAL_INT(3, static_cast<int>(lines_of(out, "jump").size()));
+}
+
 int main(void)
 {
     char tmpl[] = "/tmp/gs_test_cam_XXXXXX";
@@ -503,6 +561,8 @@ int main(void)
     RUN_TEST(test_sigterm_mid_run_flushes_summary_to_tcp_and_serial);
     RUN_TEST(test_bad_profiles_one_line_exit_2);
     RUN_TEST(test_shipped_profiles_parse);
+    RUN_TEST(test_nmea_status_sentences);
+    RUN_TEST(test_source_failure_mid_run_flushes_and_exits_1);
     int rc = UNITY_END();
     std::string rm = "rm -rf '" + g_dir + "'";
     if (!std::getenv("GS_KEEP_TMP") && std::system(rm.c_str()) != 0) std::fprintf(stderr, "cannot remove %s\n", g_dir.c_str());
