@@ -475,6 +475,7 @@ static void test_gstreamer_videotestsrc(void)
         std::string err;
         gs::CaptureError kind;
         auto cap = gs::open_capture(c, err, kind);
+        err += " (videotestsrc is in gstreamer1.0-plugins-base: tools/setup_cam.sh)";
         TEST_ASSERT_NOT_NULL_MESSAGE(cap.get(), err.c_str());
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, 30.0, cap->fps());
         TEST_ASSERT_EQUAL_STRING(mode, cap->time_origin());
