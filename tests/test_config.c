@@ -2,6 +2,7 @@
  * and the shipped firmware_cfg files read from disk. */
 #include "gravscale/gs_config.h"
 #include "unity.h"
+#include "gs_profile.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -389,7 +390,17 @@ void test_firmware_kiosk_cfg(void)
     static char text[16384];
     size_t n = read_file("firmware_cfg/kiosk.cfg", text, sizeof text);
     gs_cfg_error err;
-    TEST_ASSERT_EQUAL_INT_MESSAGE(GS_OK, parse(text, n, &err), err.msg);
+    /* as replay reads it: [core], the cam and sink sections skipped */
+    gs_cfg_section sec[1 + GS_PROFILE_SECTIONS];
+    static const char *const own[] = {"core"};
+    gs_core_config_default(&g_core);
+    sec[0] = (gs_cfg_section){"core", gs_core_config_set, &g_core};
+    size_t ns = 1 + gs_profile_foreign_sections(own, 1, sec + 1, GS_PROFILE_SECTIONS);
+    TEST_ASSERT_EQUAL_INT(GS_PROFILE_SECTIONS, (int)ns);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(GS_OK, gs_cfg_parse(text, n, sec, ns, &err), err.msg);
+    /* a section nobody reads is still an error */
+    TEST_ASSERT_EQUAL_INT(GS_ENOKEY, gs_cfg_parse("[camera]\nx = 1\n", 15, sec, ns, &err));
+    TEST_ASSERT_EQUAL_UINT32(1, err.line);
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_core_config_check(&g_core, &err));
     TEST_ASSERT_EQUAL_DOUBLE(52.52, g_core.latitude_deg);
     TEST_ASSERT_DOUBLE_WITHIN(1e-3, 9.8127, gs_core_config_g(&g_core)); /* Berlin, 34 m */

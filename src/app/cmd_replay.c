@@ -13,6 +13,7 @@
 #include "gravscale/gravscale.h"
 #include "gs_kpread.h"
 #include "gs_out.h"
+#include "gs_profile.h"
 
 /* Declared in main.c as well (no app header yet). */
 int gs_cmd_replay(int argc, char **argv);
@@ -232,11 +233,14 @@ static int load_config(const char *path, gs_core_config *cfg)
         free(text);
         return EXIT_USAGE;
     }
-    /* only [core] for now: the ball, pose, sinks and camera layers add their sections later */
-    const gs_cfg_section sections[] = {{"core", gs_core_config_set, cfg}};
+    /* [core]; the other sections of a profile belong to video and cam (gs_profile.h) */
+    gs_cfg_section sections[1 + GS_PROFILE_SECTIONS];
+    static const char *const own[] = {"core"};
+    sections[0] = (gs_cfg_section){"core", gs_core_config_set, cfg};
+    size_t n_sections = 1 + gs_profile_foreign_sections(own, 1, sections + 1, GS_PROFILE_SECTIONS);
     gs_cfg_error e;
     memset(&e, 0, sizeof e);
-    gs_status st = gs_cfg_parse(text, n, sections, sizeof sections / sizeof sections[0], &e);
+    gs_status st = gs_cfg_parse(text, n, sections, n_sections, &e);
     free(text);
     if (st == GS_OK) {
         memset(&e, 0, sizeof e);

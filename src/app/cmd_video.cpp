@@ -31,6 +31,7 @@
 extern "C" {
 #include "gravscale/gravscale.h"
 #include "gs_out.h"
+#include "gs_profile.h"
 }
 
 extern "C" int gs_cmd_video(int argc, char **argv);
@@ -207,12 +208,15 @@ int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::B
                      static_cast<unsigned>(kConfigMaxBytes));
         return EXIT_USAGE;
     }
-    const gs_cfg_section sections[] = {{"core", gs_core_config_set, &cfg},
-                                       {"ball", gs::ball_config_set, &ball},
-                                       {"pose", gs::pose_config_set, &pose}};
+    // [core], [ball] and [pose]; the other sections of a profile belong to cam (gs_profile.h)
+    gs_cfg_section sections[3 + GS_PROFILE_SECTIONS] = {{"core", gs_core_config_set, &cfg},
+                                                        {"ball", gs::ball_config_set, &ball},
+                                                        {"pose", gs::pose_config_set, &pose}};
+    static const char *const own[] = {"core", "ball", "pose"};
+    size_t n_sections = 3 + gs_profile_foreign_sections(own, 3, sections + 3, GS_PROFILE_SECTIONS);
     gs_cfg_error e;
     std::memset(&e, 0, sizeof e);
-    gs_status st = gs_cfg_parse(text.data(), n, sections, sizeof sections / sizeof sections[0], &e);
+    gs_status st = gs_cfg_parse(text.data(), n, sections, n_sections, &e);
     if (st == GS_OK) {
         std::memset(&e, 0, sizeof e);
         st = gs_core_config_check(&cfg, &e);

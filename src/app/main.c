@@ -9,6 +9,8 @@ int gs_cmd_replay(int argc, char **argv);
 #if defined(GS_HAVE_VISION) && GS_HAVE_VISION
 /* Defined in cmd_video.cpp (C++, extern "C"). */
 int gs_cmd_video(int argc, char **argv);
+/* Defined in cmd_cam.cpp (C++, extern "C"). */
+int gs_cmd_cam(int argc, char **argv);
 #endif
 
 static void usage(FILE *f)
@@ -55,6 +57,15 @@ int main(int argc, char **argv)
         return gs_cmd_video(argc - 1, argv + 1);
 #else
         fputs("gravscale: built without OpenCV: the video command is not available "
+              "(install libopencv-dev and libavformat-dev, then rebuild)\n", stderr);
+        return 2;
+#endif
+    }
+    if (strcmp(cmd, "cam") == 0) {
+#if defined(GS_HAVE_VISION) && GS_HAVE_VISION
+        return gs_cmd_cam(argc - 1, argv + 1);
+#else
+        fputs("gravscale: built without OpenCV: the cam command is not available "
               "(install libopencv-dev and libavformat-dev, then rebuild)\n", stderr);
         return 2;
 #endif
