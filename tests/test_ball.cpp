@@ -365,7 +365,8 @@ void test_rendered_two_balls_with_distractors(void)
     TEST_ASSERT_EQUAL_MESSAGE(2, (int)pf.size(), "both balls observed");
     for (size_t b = 0; b < pf.size(); b++)
         for (const auto &p : pf[b])
-            TEST_ASSERT_TRUE_MESSAGE(std::hypot(p.second.x_px - p.first.x, p.second.y_px - p.first.y) < 3.0,
+            // a distractor is tens of px away; the centre's accuracy is the single-ball test's (0.35 px median)
+            TEST_ASSERT_TRUE_MESSAGE(std::hypot(p.second.x_px - p.first.x, p.second.y_px - p.first.y) < 6.0,
                                      "every observation is on a ball, none on a distractor");
     std::map<int, int> tracks;
     for (const auto &f : run.flights) tracks[f.track]++;

@@ -38,6 +38,8 @@ struct BallConfig {
     int roi_x = 0, roi_y = 0, roi_w = 0, roi_h = 0;
     double motion_min = 18.0;      // 1..255: colour difference to the background that counts as motion
     double max_blur_ratio = 1.6;   // length/width above which no diameter is given
+    double psf_sigma_px = 1.0;     // the camera's own blur (lens, demosaicing, compression), 1 sigma:
+                                   // its variance is taken off the ball's across-motion variance
 };
 
 // gs_cfg_handler for [ball]; ctx is a BallConfig*.
