@@ -28,6 +28,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+bash tools/setup_cam.sh      # GStreamer base plugins (videotestsrc) and libcamera-dev for gravscale cam
 bash tools/fetch_unity.sh
 bash tools/fetch_models.sh   # BlazePose: npm package -> ONNX in models/ (checksummed)
 
