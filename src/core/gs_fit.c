@@ -154,7 +154,8 @@ gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
         out->vy_px_s = (double)(cy[1] / ts);
         out->ay_px_s2 = (double)ay;
         out->a_px_s2 = (double)sqrt(ax * ax + ay * ay);
-        out->g_dir_deg = (double)(atan2(ax, ay) * rad_to_deg);
+        out->g_dir_deg = GS_REAL_IS_FLOAT ? (double)(gs_atan2f((float)ax, (float)ay) * (float)rad_to_deg)
+                                         : (double)(atan2(ax, ay) * rad_to_deg);
     }
     ssr = f->ssr_x + f->ssr_y;
     out->rms_px = (double)sqrt(ssr / f->sum_w);
