@@ -55,7 +55,7 @@ static int rix(int i, int j)
     return base[i] + (j - i);
 }
 
-void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w)
+void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
 {
     gs_real v[3], bx, by, sw, tau;
     int k, j;
