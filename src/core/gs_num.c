@@ -152,6 +152,15 @@ static uint32_t big_divmod_small(gs_big *b, uint32_t d)
 
 /* ------------------------------------------------------------------ parse */
 
+/* 2^k for -1022 <= k <= 1023, from its bits */
+static double pow2(int k)
+{
+    uint64_t bits = (uint64_t)(k + 1023) << 52;
+    double d;
+    memcpy(&d, &bits, sizeof d);
+    return d;
+}
+
 /* value = (q + f) * 2^-s with 0 <= f < 1, f > 0 iff sticky; round half even
  * to the nearest double (subnormals included). false on overflow. */
 static bool round_to_double(uint64_t q, bool sticky, int64_t s, bool neg, double *out)
@@ -179,7 +188,13 @@ static bool round_to_double(uint64_t q, bool sticky, int64_t s, bool neg, double
     } else {
         drop = 0; /* q holds >= 54 bits whenever sticky is set, so this is exact */
     }
-    double r = ldexp((double)qr, (int)(drop - s));
+    /* qr * 2^k is representable (qr was rounded to the bits it keeps): scaling by
+     * exact powers of two in steps that stay normal is exact (no ldexp linked) */
+    double r = (double)qr;
+    int64_t k = drop - s;
+    while (k > 1000) { r *= pow2(1000); k -= 1000; }
+    while (k < -1000) { r *= pow2(-1000); k += 1000; }
+    r *= pow2((int)k);
     if (isinf(r)) return false;
     *out = neg ? -r : r;
     return true;
@@ -414,10 +429,18 @@ typedef struct {
 
 static void dec_expand(double a, gs_dec *d)
 {
-    int e;
-    double fm = frexp(a, &e);
-    uint64_t mant = (uint64_t)ldexp(fm, 53);
-    int e2 = e - 53;
+    /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
+    uint64_t bits;
+    memcpy(&bits, &a, sizeof bits);
+    int be = (int)((bits >> 52) & 0x7FFu);
+    uint64_t mant = bits & ((1ull << 52) - 1u);
+    int e2;
+    if (be == 0) {
+        e2 = -1074;  /* subnormal */
+    } else {
+        mant |= 1ull << 52;
+        e2 = be - 1075;
+    }
     while (!(mant & 1u)) {
         mant >>= 1;
         e2++;
