@@ -138,13 +138,13 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
     sort_asc(v, n);
     double med = median_sorted(v, n);
     out->height_m = med;
-    double rms_se = n_se > 0 ? sqrt(se2_sum / n_se) : (double)NAN;
+    double rms_se = n_se > 0 ? GS_SQRT(se2_sum / n_se) : (double)NAN;
 
     double half;
     if (n == 1) {
         double tau = SINGLE_FLIGHT_REL_SPREAD * med;
         double se = isnan(rms_se) ? 0.0 : rms_se;
-        half = 1.96 * sqrt(se * se + tau * tau);
+        half = 1.96 * GS_SQRT(se * se + tau * tau);
     } else {
         /* Between-flight spread: MAD, scaled to a normal sigma, small-sample corrected. */
         for (uint32_t i = 0; i < n; i++) {
@@ -165,7 +165,7 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
             q = t975((double)(n - 1u) * s4 / (excess2 * excess2));
         }
         double k = n < 6 ? k_median_se[n] : MEDIAN_SE_FACTOR;
-        half = q * k * sigma / sqrt((double)n);
+        half = q * k * sigma / GS_SQRT((double)n);
     }
     if (isfinite(half)) {
         out->ci95_lo_m = med - half;
