@@ -17,5 +17,7 @@ float gs_cosf(float x);
 #define GS_REAL_IS_FLOAT (sizeof(gs_real) < sizeof(double))
 #define GS_ACOSF(x) (GS_REAL_IS_FLOAT ? gs_acosf(x) : acosf(x))
 #define GS_ATAN2F(y, x) (GS_REAL_IS_FLOAT ? gs_atan2f(y, x) : atan2f(y, x))
+/* |x| of a gs_real, exactly libm's fabs where gs_real is double */
+#define GS_FABSR(x) (GS_REAL_IS_FLOAT ? (gs_real)fabsf((float)(x)) : (gs_real)fabs((double)(x)))
 
 #endif

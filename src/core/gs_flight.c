@@ -32,9 +32,8 @@
 #define DBG(...) ((void)0)
 #endif
 
-/* |x| and ceil(x) of a gs_real: libm's double functions where gs_real is double (hosts keep
+/* ceil(x) of a gs_real: libm's double functions where gs_real is double (hosts keep
  * their exact results), single precision where it is float (ceil only of small, finite x) */
-#define FABS_R(x) (GS_REAL_IS_FLOAT ? (gs_real)fabsf((float)(x)) : (gs_real)fabs((double)(x)))
 #define CEIL_R(x) (GS_REAL_IS_FLOAT ? ceil_f((float)(x)) : (gs_real)ceil((double)(x)))
 static gs_real ceil_f(float x)
 {
@@ -532,7 +531,7 @@ static gs_real median_se(const float *v, uint32_t n, gs_real *se_out)
     for (uint32_t i = 0; i < n; i++) tmp[i] = v[i];
     gs_real med = median_f(tmp, n);
     if (n >= 2) {
-        for (uint32_t i = 0; i < n; i++) dev[i] = (float)FABS_R((gs_real)tmp[i] - med);
+        for (uint32_t i = 0; i < n; i++) dev[i] = (float)GS_FABSR((gs_real)tmp[i] - med);
         *se_out = GS_R(1.2533) * median_f(dev, n) * GS_R(1.4826) / GS_SQRT((gs_real)n);
     } else {
         *se_out = NAN;
@@ -812,7 +811,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
         if (truncated) j->warnings |= GS_WARN_CLIPPED;
         if (f->n_flights > 0 && isfinite(f->last_g_dir_deg) &&
-            FABS_R(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
+            GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
             j->warnings |= GS_WARN_GRAVITY_TILT;
     }
 
@@ -863,7 +862,7 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
     gs_sample_full b_b;
     const gs_sample_full *b = at(f, idx - k, &b_b);
     if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
-    return FABS_R(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
+    return GS_FABSR(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
 }
 
 static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed)
@@ -951,7 +950,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
-        f->noise_init[f->noise_n++] = (float)FABS_R(d2);
+        f->noise_init[f->noise_n++] = (float)GS_FABSR(d2);
         if (f->noise_n == NOISE_INIT_N) {
             float tmp[NOISE_INIT_N];
             for (uint32_t i = 0; i < NOISE_INIT_N; i++) tmp[i] = f->noise_init[i];
@@ -960,7 +959,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
             if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
         }
     } else if (still) {
-        gs_real a = FABS_R(d2) / GS_R(1.954);  /* E|N(0, 6 s^2)| = GS_R(1.954) s */
+        gs_real a = GS_FABSR(d2) / GS_R(1.954);  /* E|N(0, 6 s^2)| = GS_R(1.954) s */
         if (a > GS_R(3.0) * f->noise_px) a = GS_R(3.0) * f->noise_px;
         f->noise_px += GS_R(0.02) * (a - f->noise_px);
     }
