@@ -137,17 +137,23 @@ static void big_shr1(gs_big *b)
     while (b->n && b->w[b->n - 1u] == 0) b->n--;
 }
 
-/* b /= d, returns the remainder */
+/* b /= d for 0 < d <= 2^16, returns the remainder. Long division in 16-bit
+ * digits: every step is a 32-bit division (one instruction on a Cortex-M4, no
+ * 64-bit division helper linked). */
 static uint32_t big_divmod_small(gs_big *b, uint32_t d)
 {
-    uint64_t rem = 0;
+    uint32_t rem = 0;
     for (uint32_t i = b->n; i-- > 0;) {
-        uint64_t cur = (rem << 32) | b->w[i];
-        b->w[i] = (uint32_t)(cur / d);
-        rem = cur % d;
+        uint32_t w = b->w[i];
+        uint32_t hi = (rem << 16) | (w >> 16);   /* rem < d <= 2^16: no overflow */
+        uint32_t qh = hi / d;
+        rem = hi % d;
+        uint32_t lo = (rem << 16) | (w & 0xFFFFu);
+        b->w[i] = (qh << 16) | (lo / d);
+        rem = lo % d;
     }
     while (b->n && b->w[b->n - 1u] == 0) b->n--;
-    return (uint32_t)rem;
+    return rem;
 }
 
 /* ------------------------------------------------------------------ parse */
@@ -419,9 +425,9 @@ bool gs_num_parse_int(const char *s, size_t len, long *out)
 
 /* ------------------------------------------------------------------ format */
 
-/* The exact decimal expansion of a > 0: a = N * 10^-p, N in base-1e9 chunks. */
+/* The exact decimal expansion of a > 0: a = N * 10^-p, N in base-1e4 chunks. */
 typedef struct {
-    uint32_t c[90]; /* c[0] least significant */
+    uint16_t c[204]; /* base-10^4 chunks, c[0] least significant (810 digits) */
     int nc;
     int nd;         /* decimal digits of N */
     int p;
@@ -456,11 +462,11 @@ static void dec_expand(double a, gs_dec *d)
         d->p = -e2;
     }
     d->nc = 0;
-    while (n.n && d->nc < 90) d->c[d->nc++] = big_divmod_small(&n, 1000000000u);
+    while (n.n && d->nc < 204) d->c[d->nc++] = (uint16_t)big_divmod_small(&n, 10000u);
     uint32_t top = d->c[d->nc - 1];
     int td = 1;
-    while (td < 9 && top >= k_pow10_u32[td]) td++;
-    d->nd = 9 * (d->nc - 1) + td;
+    while (td < 4 && top >= k_pow10_u32[td]) td++;
+    d->nd = 4 * (d->nc - 1) + td;
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -468,7 +474,7 @@ static int dec_digit(const gs_dec *d, int i)
 {
     if (i < 0 || i >= d->nd) return 0;
     int j = d->nd - 1 - i;
-    return (int)((d->c[j / 9] / k_pow10_u32[j % 9]) % 10u);
+    return (int)((d->c[j / 4] / k_pow10_u32[j % 4]) % 10u);
 }
 
 /* Keep the first n digits (n <= 30) in out[] as values 0..9, rounded half away
