@@ -298,7 +298,33 @@ static bool parse_slow(const char *s, size_t mant_len, int64_t nsig, int64_t nfr
     return round_to_double(q, sticky, sh, neg, out);
 }
 
+/* m * 10^e10 by scaling in double (m <= 19 digits): a few roundings, within 16 ulp
+ * of the correctly rounded value (relative 4e-15; subnormals lose more). */
+static bool scale_pow10(uint64_t m, int64_t e10, bool neg, double *out)
+{
+    double r = (double)m;
+    for (; e10 > 22; e10 -= 22) r *= 1e22;
+    for (; e10 < -22 && r != 0.0; e10 += 22) r /= 1e22;
+    if (e10 >= -22) r = e10 < 0 ? r / k_pow10_dbl[-e10] : r * k_pow10_dbl[e10];
+    if (isinf(r)) return false;
+    *out = neg ? -r : r;
+    return true;
+}
+
+static bool parse_impl(const char *s, size_t len, double *out, bool exact);
+
 bool gs_num_parse(const char *s, size_t len, double *out)
+{
+    /* where gs_real is float (a Cortex-M4) the exact slow path is not linked */
+    return parse_impl(s, len, out, !GS_REAL_IS_FLOAT);
+}
+
+bool gs_num_parse_scaled(const char *s, size_t len, double *out)
+{
+    return parse_impl(s, len, out, false);
+}
+
+static bool parse_impl(const char *s, size_t len, double *out, bool exact)
 {
     if (!s || !out) return false;
     size_t i = 0;
@@ -396,6 +422,7 @@ bool gs_num_parse(const char *s, size_t len, double *out)
             return true;
         }
     }
+    if (!exact) return scale_pow10(m, e10, neg, out);
     return parse_slow(s + mant_start, mant_end - mant_start, nsig, nfrac, e, neg, out);
 }
 
