@@ -64,7 +64,7 @@ typedef struct {
     gs_real cusum;             /* one-sided CUSUM of the deviation against gravity */
     uint32_t pend_ok;          /* bit k: pending sample fl_last+1+k is no gross outlier */
     uint32_t outliers_run;     /* consecutive gross outliers */
-    gs_real dt_med_s;          /* typical frame interval */
+    double dt_med_s;           /* typical frame interval (double: frame counts are taken from it) */
 
     float stand_size[GS_STAND_KEEP];
     uint32_t stand_n, stand_next;

@@ -8,16 +8,21 @@
  * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
  * the boundary) and the final robust 2D fit uses only samples in free flight.
  *
- * float vs gs_real (the Cortex-M4's FPU is single precision; gs_real is emulated):
- * what runs per sample inside the fits and per boundary candidate is gs_real
- * (float there: test_sample, pred_var_factor, piecewise_ssr, solve_spd, and all
- * of gs_fit.c). What stays gs_real, and why:
+ * float vs double (the Cortex-M4's FPU is single precision; double is emulated):
+ * the per-frame state machine (u, noise, levels, CUSUM, sizes), the per-sample
+ * and per-boundary-candidate work (test_sample, pred_var_factor, piecewise_ssr,
+ * solve_spd, all of gs_fit.c) and closing a flight (apex, SE, q, height) are
+ * gs_real: float on the M4, double on hosts (bit-identical to the all-double
+ * code). What stays double, and why:
  *  - absolute times (t_s, T0, T1, last_t_s, peak_t, blk_t0, still_since, ...):
  *    a stream runs for days and float seconds lose milliseconds after hours;
- *  - the per-frame state machine (u, noise, levels, thresholds): a few dozen
- *    operations a frame, kept gs_real so hosts keep their exact results;
- *  - closing a flight (event fields, SE, apex, jump height): once per flight,
- *    and the event's public fields are gs_real. */
+ *  - time differences compared with time thresholds (gaps, latency, settling)
+ *    and the frame interval (dt_med_s) with the frame counts taken from it by
+ *    ceil (core width, boundary grid steps, speed lag): these are knife edges
+ *    (a ratio of exactly 6 frames rounds up or not); in float they flipped
+ *    differently from the host's double on a tenth of a held-out set's
+ *    flights, in double they decide as on the host;
+ *  - the event's public fields (double). */
 #include "gravscale/gs_flight.h"
 
 #include <math.h>
@@ -32,13 +37,13 @@
 #define DBG(...) ((void)0)
 #endif
 
-/* ceil(x) of a gs_real: libm's double functions where gs_real is double (hosts keep
- * their exact results), single precision where it is float (ceil only of small, finite x) */
-#define CEIL_R(x) (GS_REAL_IS_FLOAT ? ceil_f((float)(x)) : (gs_real)ceil((double)(x)))
-static gs_real ceil_f(float x)
+/* ceil(x) of a double: libm's where gs_real is double, else the same value without
+ * libm (only of finite |x| < 2^62: frame counts) */
+#define CEIL_D(x) (GS_REAL_IS_FLOAT ? ceil_d(x) : ceil(x))
+static double ceil_d(double x)
 {
-    float t = (float)(long)x;  /* toward zero */
-    return (gs_real)(t < x ? t + 1.0f : t);
+    double t = (double)(long long)x;  /* toward zero, exact */
+    return t < x ? t + 1.0 : t;
 }
 
 /* tuning: thresholds in units of the noise or of the object's size */
@@ -46,13 +51,13 @@ static gs_real ceil_f(float x)
 #define SEED_RISE_REL    GS_R(0.03)   /* apex must rise this x size above the recent minimum */
 #define SEED_RISE_NOISE  GS_R(8.0)    /* ... and this x noise */
 #define SEED_DROP_NOISE  GS_R(2.5)    /* apex confirmed once u fell this x noise below it */
-#define CORE_HALF_S      GS_R(0.07)   /* half-width of the seed's core window */
+#define CORE_HALF_S      0.07         /* half-width of the seed's core window */
 #define CUSUM_K          GS_R(1.3)    /* CUSUM reference: deviations below k sigma drain it */
 #define CUSUM_H          GS_R(5.0)    /* CUSUM alarm: contact */
 #define VERIFY_RMS       GS_R(2.5)    /* ... and only when the refit's residual is near the noise */
 #define VERIFY_Z         GS_R(2.0)    /* after a refit through an alarm, edge samples below this: false alarm */
 #define CUSUM_ZMAX       GS_R(6.0)    /* one sample adds at most this (a lone glitch cannot end a flight) */
-#define BOUNDARY_IN_S    GS_R(0.025)  /* boundary search reaches this far (at least a frame) inside the grown flight */
+#define BOUNDARY_IN_S    0.025        /* boundary search reaches this far (at least a frame) inside the grown flight */
 #define GROSS_OUTLIER    GS_R(7.0)    /* perpendicular or downward deviation = bad keypoints, skipped */
 #define CONTACT_MIN_G    GS_R(0.5)    /* contact force past a boundary: at least half of g */
 #define DROP_PENALTY     GS_R(4.0)    /* SSR gain (x sigma^2) needed to drop a sample the online test kept */
@@ -65,7 +70,7 @@ static gs_real ceil_f(float x)
 #define LOOSE_UPRIGHT    GS_R(0.5)    /* fallback size samples (no settled stance seen yet) */
 #define MEDIAN_MAX       64     /* largest set a median is taken of */
 #define NOISE_INIT_N     9      /* second differences whose median starts the noise estimate */
-#define STAND_SETTLE_S   GS_R(0.2)    /* still this long before a frame counts as standing */
+#define STAND_SETTLE_S   0.2          /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
@@ -238,7 +243,7 @@ static gs_real pred_var_factor(const gs_fit *fit, double t_s)
 static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
                         const gs_sample_full *s, gs_real *z)
 {
-    /* per sample and per boundary candidate: gs_real; only the time difference is gs_real */
+    /* per sample and per boundary candidate: gs_real; only the time difference is double */
     gs_real dt = (gs_real)(s->t_s - r->t0_s);
     gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
     gs_real px = (gs_real)r->x0_px + (gs_real)r->vx_px_s * dt + GS_R(0.5) * ax * dt * dt;
@@ -264,9 +269,9 @@ static gs_real cusum_step(gs_real S, gs_real z)
 }
 
 /* typical frame interval from the history (for time-based spans) */
-static gs_real frame_dt(const gs_flight *f)
+static double frame_dt(const gs_flight *f)
 {
-    return (isfinite(f->dt_med_s) && f->dt_med_s > GS_R(0.0)) ? f->dt_med_s : GS_R(1.0) / GS_R(30.0);
+    return (isfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
@@ -283,7 +288,7 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
     gs_real max_ang = f->up_from_flight ? GS_R(25.0) : (f->up_n > 0 ? GS_R(40.0) : GS_R(60.0));
     max_ang += GS_R(2.0) * rel_se * GS_R(180.0) / GS_PI;
     if (max_ang > GS_R(80.0)) max_ang = GS_R(80.0);
-    /* a threshold: single precision is plenty where gs_real is emulated */
+    /* a threshold: single precision is plenty where double is emulated */
     if (!(cosang > (gs_real)GS_COS(max_ang * GS_PI / GS_R(180.0)))) return false;
     gs_real a_hi = r->a_px_s2 + GS_R(2.0) * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - GS_R(2.0) * rel_se * r->a_px_s2;
     if (isfinite(size_px) && size_px > GS_R(0.0)) {
@@ -320,8 +325,8 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, &r) != GS_OK)
         return false;
-    gs_real tspan = b->t_s - a->t_s;
-    gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > GS_R(0.0) ? tspan : frame_dt(f));
+    double tspan = b->t_s - a->t_s;
+    gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
@@ -357,10 +362,10 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     return checked == 2;
 }
 
-static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, gs_real half_s)
+static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double half_s)
 {
-    gs_real dt = frame_dt(f);
-    uint32_t half = (uint32_t)CEIL_R(half_s / dt - (GS_REAL_IS_FLOAT ? GS_R(1e-5) : GS_R(1e-9)));  /* a ratio that is whole up to rounding */
+    double dt = frame_dt(f);
+    uint32_t half = (uint32_t)CEIL_D(half_s / dt - 1e-9);
     if (half < 2) half = 2;
     uint64_t lo = apex >= f->quiet_from + half ? apex - half : f->quiet_from;
     uint64_t hi = apex + half < newest ? apex + half : newest;
@@ -396,7 +401,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, gs_rea
 /* Seed a flight at an apex: fit a core around it, wider when noise hides the curve. */
 static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
 {
-    static const gs_real half_s[] = {CORE_HALF_S, CORE_HALF_S * GS_R(1.45), CORE_HALF_S * GS_R(1.9)};
+    static const double half_s[] = {CORE_HALF_S, CORE_HALF_S * 1.45, CORE_HALF_S * 1.9};
     for (unsigned k = 0; k < sizeof half_s / sizeof half_s[0]; k++)
         if (seed_core_width(f, apex, newest, half_s[k])) return true;
     return false;
@@ -456,7 +461,7 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
         gs_real z;
         if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
         gs_real w = (gs_real)s->w;
-        gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in gs_real */
+        gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
         gs_real d = (gs_real)(side < 0 ? (T - s->t_s) : (s->t_s - T));
         gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
         gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
@@ -502,11 +507,11 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
     double tc = 0.5 * (a->t_s + b->t_s), ts = 0.5 * (b->t_s - a->t_s);
     if (!(ts > 0.0)) return NAN;
     /* search between the outermost contact sample and a little inside the flight */
-    gs_real dt = frame_dt(f);
-    gs_real inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
+    double dt = frame_dt(f);
+    double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
     double t_from = eo->t_s, t_to = ei->t_s + (side < 0 ? inside : -inside);
     if (side > 0) { double tmp = t_from; t_from = t_to; t_to = tmp; }
-    int steps = (int)CEIL_R((gs_real)(t_to - t_from) / dt * BOUNDARY_STEPS);
+    int steps = (int)CEIL_D((t_to - t_from) / dt * BOUNDARY_STEPS);
     if (steps < 1) steps = 1;
     if (steps > 400) steps = 400;
     gs_real best = INFINITY;
@@ -569,7 +574,7 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
 static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
 {
     uint64_t alarm = UINT64_MAX;
-    gs_real max_gap = (gs_real)f->cfg->max_gap_s;
+    double max_gap = (double)f->cfg->max_gap_s;
     uint32_t outl = 0;
     gs_real S = GS_R(0.0);
     uint64_t oldest = gs_ring_oldest(f->ring);
@@ -587,8 +592,8 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s) break;
         if (!usable(s)) continue;
-        if ((gs_real)(t_prev - s->t_s) > max_gap) break;
-        if (sd && (gs_real)(sd->t_s - s->t_s) > (gs_real)f->cfg->max_flight_s) break;
+        if (t_prev - s->t_s > max_gap) break;
+        if (sd && sd->t_s - s->t_s > (double)f->cfg->max_flight_s) break;
         t_prev = s->t_s;
         gs_real z;
         if (!test_sample(f, &f->fit, r, s, &z)) {
@@ -658,7 +663,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 {
     uint64_t land_idx = UINT64_MAX;  /* first sample after the flight */
     gs_fit_result r;
-    gs_real dt = frame_dt(f);
+    double dt = frame_dt(f);
     if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
     uint64_t left_alarm = grow_left(f, &r);
 
@@ -726,13 +731,13 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
-    gs_real max_gap_in = GS_R(0.0);
+    double max_gap_in = 0.0;
     double t_prev = NAN;
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s || !(s->w > 0.0f) || !isfinite(s->t_s)) continue;  /* frames missing from the source */
-        if (isfinite(t_prev) && (gs_real)(s->t_s - t_prev) > max_gap_in) max_gap_in = (gs_real)(s->t_s - t_prev);
+        if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
@@ -740,8 +745,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    if (!isfinite(T0)) T0 = sf->t_s - (double)(GS_R(0.5) * dt);
-    if (!isfinite(T1)) T1 = sl->t_s + (double)(GS_R(0.5) * dt);
+    if (!isfinite(T0)) T0 = sf->t_s - 0.5 * dt;
+    if (!isfinite(T1)) T1 = sl->t_s + 0.5 * dt;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -795,7 +800,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
         if (n_in < f->cfg->min_samples || (gs_real)j->flight_time_s < (gs_real)f->cfg->min_flight_s)
             j->reason = GS_REJ_FEW_SAMPLES;
-        else if (max_gap_in > (gs_real)f->cfg->max_gap_s)
+        else if (max_gap_in > (double)f->cfg->max_gap_s)
             j->reason = GS_REJ_GAP;
         else if (!isfinite(size))
             j->reason = GS_REJ_NO_SIZE;
@@ -856,7 +861,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 /* |du/dt| against the sample about GS_R(0.1) s back (frame jitter is not motion); NaN unknown */
 static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u)
 {
-    uint64_t k = (uint32_t)CEIL_R(GS_R(0.1) / frame_dt(f));
+    uint64_t k = (uint64_t)CEIL_D(0.1 / frame_dt(f));
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
@@ -878,7 +883,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
         if (f->loose_n < GS_STAND_KEEP) f->loose_n++;
     }
     if (!(s->upright >= STAND_UPRIGHT)) return;
-    if ((gs_real)(s->t_s - f->still_since) < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
+    if (s->t_s - f->still_since < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
     f->stand_size[f->stand_next] = s->size_px;
     f->stand_next = (f->stand_next + 1u) % GS_STAND_KEEP;
     if (f->stand_n < GS_STAND_KEEP) f->stand_n++;
@@ -967,7 +972,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 
     /* recent minimum over two half-second blocks */
     if (!isfinite(f->blk_t0)) f->blk_t0 = tm;
-    if ((gs_real)(tm - f->blk_t0) > GS_R(0.5)) {
+    if (tm - f->blk_t0 > 0.5) {
         f->blk_min_prev = f->blk_min_cur;
         f->blk_min_cur = INFINITY;
         f->blk_t0 = tm;
@@ -1018,7 +1023,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     gs_sample_full seed_b;
     const gs_sample_full *seed = at(f, f->seed_idx, &seed_b);
     if (gs_fit_solve(&f->fit, &r) != GS_OK ||
-        (seed && (gs_real)(s->t_s - seed->t_s) > (gs_real)f->cfg->max_flight_s)) {
+        (seed && s->t_s - seed->t_s > (double)f->cfg->max_flight_s)) {
         land(f, idx, UINT64_MAX, s);
         return;
     }
@@ -1040,7 +1045,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     /* deviations that persist for the configured latency end the flight, alarm or not */
     gs_sample_full edge_b;
     const gs_sample_full *edge = at(f, f->fl_last, &edge_b);
-    if (f->cusum > GS_R(0.0) && edge && (gs_real)(s->t_s - edge->t_s) > (gs_real)f->cfg->landing_latency_s) {
+    if (f->cusum > GS_R(0.0) && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
         land(f, idx, idx, s);
         return;
     }
@@ -1083,12 +1088,12 @@ void gs_flight_update(gs_flight *f)
         if (present && !usable(s)) { f->last_t_s = s->t_s; continue; }
         if (!present) continue;
         if (isfinite(f->last_t_s)) {
-            gs_real dt = (gs_real)(s->t_s - f->last_t_s);
+            double dt = s->t_s - f->last_t_s;
             if (dt > GS_R(0.0)) {
                 if (!isfinite(f->dt_med_s)) f->dt_med_s = dt;
-                else if (dt < GS_R(3.0) * f->dt_med_s) f->dt_med_s += GS_R(0.05) * (dt - f->dt_med_s);
+                else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
             }
-            if (dt > (gs_real)f->cfg->max_gap_s) {
+            if (dt > (double)f->cfg->max_gap_s) {
                 if (f->state == GS_FS_AIRBORNE) {
                     close_candidate(f, f->last_idx, UINT64_MAX, true);
                 }
