@@ -13,7 +13,7 @@
  * assumed instead: 3 % of the value, 5 cm at 1.75 m. */
 #define SINGLE_FLIGHT_REL_SPREAD GS_R(0.03)
 
-#define MAD_TO_SIGMA GS_R(1.4826) /* 1 / Phi^-1(GS_R(0.75)) */
+#define MAD_TO_SIGMA GS_R(1.4826) /* 1 / Phi^-1(0.75) */
 #define MEDIAN_SE_FACTOR GS_R(1.2533) /* sqrt(pi/2): SE(median) / SE(mean), large n, normal data */
 
 /* Small-sample correction of the MAD (Croux & Rousseeuw 1992), n = 2..9;
@@ -35,7 +35,7 @@ static const struct {
 #define N_T975 (sizeof k_t975 / sizeof k_t975[0])
 
 /* t quantile for a real dof >= 1, linear in 1/dof between table rows (exact
- * at the rows, GS_R(1.96) at infinity). */
+ * at the rows, 1.96 at infinity). */
 static gs_real t975(gs_real dof)
 {
     if (!(dof > GS_R(1.0))) {

@@ -858,7 +858,7 @@ done:
 
 static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s);
 
-/* |du/dt| against the sample about GS_R(0.1) s back (frame jitter is not motion); NaN unknown */
+/* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
 static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u)
 {
     uint64_t k = (uint64_t)CEIL_D(0.1 / frame_dt(f));
@@ -960,11 +960,11 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
             float tmp[NOISE_INIT_N];
             for (uint32_t i = 0; i < NOISE_INIT_N; i++) tmp[i] = f->noise_init[i];
             gs_real med = median_f(tmp, NOISE_INIT_N);
-            f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = GS_R(1.652) s */
+            f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = 1.652 s */
             if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
         }
     } else if (still) {
-        gs_real a = GS_FABSR(d2) / GS_R(1.954);  /* E|N(0, 6 s^2)| = GS_R(1.954) s */
+        gs_real a = GS_FABSR(d2) / GS_R(1.954);  /* E|N(0, 6 s^2)| = 1.954 s */
         if (a > GS_R(3.0) * f->noise_px) a = GS_R(3.0) * f->noise_px;
         f->noise_px += GS_R(0.02) * (a - f->noise_px);
     }
