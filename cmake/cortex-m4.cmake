@@ -9,8 +9,19 @@ set(CMAKE_ASM_COMPILER arm-none-eabi-gcc)
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
 set(GS_M4_CPU_FLAGS "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16")
-set(CMAKE_C_FLAGS_INIT "${GS_M4_CPU_FLAGS} -ffunction-sections -fdata-sections")
+# -fno-math-errno: sqrtf is then the VSQRT instruction (no errno call on a negative
+# argument; the value, NaN, is the same). Not -ffast-math: no result changes.
+set(CMAKE_C_FLAGS_INIT "${GS_M4_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-math-errno")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "${GS_M4_CPU_FLAGS} --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections")
+# GS_FW_LTO=ON (the cortex-m4 preset, tools/firmware_size.sh): link-time optimisation
+# across the core's files (inlining, dead code), measured in docs/firmware.md. Fat
+# objects keep the archive readable by nm and -fstack-usage's per-file frames.
+if(GS_FW_LTO)
+  string(APPEND CMAKE_C_FLAGS_INIT " -flto -ffat-lto-objects")
+  string(APPEND CMAKE_EXE_LINKER_FLAGS_INIT " -flto -Os")
+  set(CMAKE_AR arm-none-eabi-gcc-ar)
+  set(CMAKE_RANLIB arm-none-eabi-gcc-ranlib)
+endif()
 
 # libm by name: the driver picks the multilib for the flags above (a found path
 # would be the wrong, soft-float one)

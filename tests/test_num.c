@@ -99,6 +99,48 @@ void test_parse_table(void)
     TEST_ASSERT_FALSE(gs_num_parse(NULL, 0, &z));
 }
 
+/* the float builds' parser (gs_num_parse_scaled): the same accept/reject decisions,
+ * values within 16 ulp of strtod's for normal doubles */
+void test_parse_scaled(void)
+{
+    for (size_t i = 0; i < sizeof k_parse_cases / sizeof k_parse_cases[0]; i++) {
+        const parse_case *c = &k_parse_cases[i];
+        double got = 0.0, want = 0.0;
+        bool ok = gs_num_parse_scaled(c->in, strlen(c->in), &got);
+        bool ok_exact = gs_num_parse(c->in, strlen(c->in), &want);
+        if (ok_exact && fabs(want) > 1.7976931348623e308) continue;  /* within 16 ulp of DBL_MAX may overflow */
+        TEST_ASSERT_EQUAL_MESSAGE(ok_exact, ok, c->in);
+        if (ok && isnormal(want)) {
+            TEST_ASSERT_TRUE_MESSAGE(ulp_dist(want, got) <= 16, c->in);
+        }
+    }
+    static const char *fmts[] = {"%.17g", "%.21e", "%.25g", "%.9e", "%.3f"};
+    char s[64];
+    uint64_t worst = 0;
+    uint64_t rng_saved = g_rng;  /* the other tests keep their random sequences */
+    for (int it = 0; it < 20000; it++) {
+        double v = it % 2 ? ldexp(rnd_unit() + 0.5, (int)(rnd64() % 2000) - 1000) : (rnd_unit() - 0.5) * 4000.0;
+        for (size_t f = 0; f < sizeof fmts / sizeof fmts[0]; f++) {
+            int len = snprintf(s, sizeof s, fmts[f], v);
+            if (len <= 0 || len >= (int)sizeof s) continue;
+            double ref = strtod(s, NULL), got = 0.0;
+            TEST_ASSERT_TRUE_MESSAGE(gs_num_parse_scaled(s, (size_t)len, &got), s);
+            if (!isnormal(ref)) continue;
+            uint64_t d = ulp_dist(ref, got);
+            TEST_ASSERT_TRUE_MESSAGE(d <= 16, s);
+            if (d > worst) worst = d;
+        }
+    }
+    g_rng = rng_saved;
+    printf("parse_scaled: worst %llu ulp\n", (unsigned long long)worst);
+    /* what a profile holds: short decimals are exact */
+    double x = 0.0;
+    TEST_ASSERT_TRUE(gs_num_parse_scaled("0.02", 4, &x));
+    TEST_ASSERT_EQUAL_DOUBLE(0.02, x);
+    TEST_ASSERT_TRUE(gs_num_parse_scaled("2.5", 3, &x));
+    TEST_ASSERT_EQUAL_DOUBLE(2.5, x);
+}
+
 /* --------------------------------------------------------- parse random */
 /* significant digits of a decimal string's mantissa (trailing zeros count) */
 static int sig_digits(const char *s)
@@ -460,6 +502,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_parse_table);
     RUN_TEST(test_parse_random_vs_strtod);
+    RUN_TEST(test_parse_scaled);
     RUN_TEST(test_parse_long_digits_exact);
     RUN_TEST(test_parse_speed);
     RUN_TEST(test_parse_int_table);

@@ -8,6 +8,7 @@
 # 2: no cross compiler or the build failed. The code target (24 KB) is reported, and
 # enforced only with GS_FW_STRICT=1 (docs/firmware.md says where the bytes are).
 # GS_FW_REAL=double builds the fits in double instead of float (for comparison).
+# GS_FW_LTO=OFF links the firmware without link-time optimisation.
 set -eu
 top=$(cd "$(dirname "$0")/.." && pwd)
 bdir=${1:-$top/build-m4}
@@ -22,17 +23,30 @@ for t in arm-none-eabi-gcc arm-none-eabi-nm arm-none-eabi-size cmake; do
 done
 gen=""
 command -v ninja >/dev/null 2>&1 && gen="-G Ninja"
-if ! cmake -S "$top" -B "$bdir" $gen -DCMAKE_TOOLCHAIN_FILE="$top/cmake/cortex-m4.cmake" \
-     -DGS_BUILD_HOST=OFF -DGS_REAL=${GS_FW_REAL:-float} -DCMAKE_BUILD_TYPE=MinSizeRel >"$bdir.configure.log" 2>&1; then
-  cat "$bdir.configure.log" >&2; echo "firmware_size: configure failed" >&2; exit 2
-fi
-rm -f "$bdir.configure.log"
-if ! cmake --build "$bdir" >"$bdir/build.log" 2>&1; then
-  cat "$bdir/build.log" >&2; echo "firmware_size: build failed" >&2; exit 2
-fi
+lto=${GS_FW_LTO:-ON}
+# build_fw DIR LTO: configure and build the firmware in DIR
+build_fw() {
+  if ! cmake -S "$top" -B "$1" $gen -DCMAKE_TOOLCHAIN_FILE="$top/cmake/cortex-m4.cmake" -DGS_FW_LTO=$2 \
+       -DGS_BUILD_HOST=OFF -DGS_REAL=${GS_FW_REAL:-float} -DCMAKE_BUILD_TYPE=MinSizeRel >"$1.configure.log" 2>&1; then
+    cat "$1.configure.log" >&2; echo "firmware_size: configure failed" >&2; exit 2
+  fi
+  rm -f "$1.configure.log"
+  if ! cmake --build "$1" >"$1/build.log" 2>&1; then
+    cat "$1/build.log" >&2; echo "firmware_size: build failed" >&2; exit 2
+  fi
+}
+build_fw "$bdir" "$lto"
 elf=$bdir/gravscale_fw.elf
-map=$bdir/gravscale_fw.map
-lib=$bdir/libgravscale_core.a
+# the firmware is linked with LTO (GS_FW_LTO=OFF: without); the breakdown by file, the
+# core library's references and its stack frames come from a build without LTO (LTO
+# merges the files), in $bdir/nolto
+nbdir=$bdir
+if [ "$lto" != OFF ]; then
+  nbdir=$bdir/nolto
+  build_fw "$nbdir" OFF
+fi
+map=$nbdir/gravscale_fw.map
+lib=$nbdir/libgravscale_core.a
 fail=0
 
 # 1. nothing from the heap, printf or strtod families is linked (nor sbrk, which a heap needs)
@@ -60,7 +74,8 @@ arm-none-eabi-size "$elf"
 set -- $(arm-none-eabi-size "$elf" | awk 'NR == 2 {print $1, $2, $3}')
 text=$1; data=$2; bss=$3
 # linked bytes per input file, from the map (after --gc-sections)
-echo "--- linked code+rodata by origin (bytes)"
+[ "$nbdir" = "$bdir" ] || echo "--- without LTO: $(arm-none-eabi-size "$nbdir/gravscale_fw.elf" | awk 'NR == 2 {print $1 " text + " $2 " data = " $1 + $2}') B"
+echo "--- linked code+rodata by origin (bytes, without LTO)"
 awk '
   function hex(s,   i, c, v) { v = 0; s = tolower(substr(s, 3)); for (i = 1; i <= length(s); i++) { c = index("0123456789abcdef", substr(s, i, 1)) - 1; v = v * 16 + c } return v }
   /^Linker script and memory map/ {on = 1; next}
@@ -86,7 +101,7 @@ else
 fi
 code=$((text + data))
 echo "--- budgets"
-echo "code (flash: text + data)      : $code B (core $core B); target <= $CODE_TARGET B"
+echo "code (flash: text + data)      : $code B (core $core B without LTO); target <= $CODE_TARGET B"
 if [ "$code" -gt "$CODE_TARGET" ]; then
   if [ "${GS_FW_STRICT:-0}" = 1 ]; then echo "FAIL code over the target"; fail=1; else echo "OVER code target (reported; GS_FW_STRICT=1 enforces it)"; fi
 else
@@ -106,10 +121,10 @@ else
   echo "ok   state within budget"
 fi
 # deepest stack frames of the core (-fstack-usage), for the stack reserve
-su=$(find "$bdir/CMakeFiles/gravscale_core.dir" -name '*.su' 2>/dev/null | head -1)
+su=$(find "$nbdir/CMakeFiles/gravscale_core.dir" -name '*.su' 2>/dev/null | head -1)
 if [ -n "$su" ]; then
-  echo "--- largest core stack frames (bytes)"
-  find "$bdir/CMakeFiles/gravscale_core.dir" -name '*.su' -exec cat {} + | sort -t'	' -k2 -n -r | head -5 |
+  echo "--- largest core stack frames (bytes, without LTO)"
+  find "$nbdir/CMakeFiles/gravscale_core.dir" -name '*.su' -exec cat {} + | sort -t'	' -k2 -n -r | head -5 |
     awk -F'\t' '{n = split($1, a, ":"); printf "%7d  %s\n", $2, a[n]}'
 fi
 # 3. run it: QEMU's Cortex-M4 board (netduinoplus2, STM32F405) with semihosting prints the

@@ -18,12 +18,12 @@ typedef struct {
 
 typedef struct {
     double t0_s;              /* reference time of the coefficients */
-    double x0_px, vx_px_s, ax_px_s2;  /* x(t) = x0 + vx*(t-t0) + ax/2*(t-t0)^2 */
-    double y0_px, vy_px_s, ay_px_s2;
-    double a_px_s2;           /* |(ax, ay)| */
-    double a_se_px_s2;        /* standard error of a_px_s2 */
-    double g_dir_deg;         /* direction of (ax, ay) from image down (+y), positive toward +x */
-    double rms_px;            /* weighted RMS of the 2D residual */
+    gs_real x0_px, vx_px_s, ax_px_s2;  /* x(t) = x0 + vx*(t-t0) + ax/2*(t-t0)^2 */
+    gs_real y0_px, vy_px_s, ay_px_s2;
+    gs_real a_px_s2;          /* |(ax, ay)| */
+    gs_real a_se_px_s2;       /* standard error of a_px_s2 */
+    gs_real g_dir_deg;        /* direction of (ax, ay) from image down (+y), positive toward +x */
+    gs_real rms_px;           /* weighted RMS of the 2D residual */
     uint32_t n;
 } gs_fit_result;
 
@@ -31,7 +31,7 @@ typedef struct {
  * sample); tscale_s > 0: about the window's length. */
 void gs_fit_init(gs_fit *f, double t0_s, double tscale_s);
 /* Add one sample with weight w >= 0 (w == 0 or non-finite values are ignored). */
-void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w);
+void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w);
 /* Solve. GS_EINVAL when fewer than 3 weighted samples or the design is singular
  * (e.g. fewer than 3 distinct times). With exactly 3 the exact parabola is
  * returned and a_se_px_s2 is NaN (no degrees of freedom). */

@@ -31,7 +31,7 @@ typedef struct {
     bool trace;
     bool rigid;                /* object size is measured in every frame (ball), not while standing */
     uint32_t track;            /* reported in every event (several objects: one pipeline each) */
-    double g_m_s2;             /* double here and below: per-frame or per-flight state (gs_flight.c says why) */
+    gs_real g_m_s2;            /* gs_real here and below; times stay double (gs_flight.c says why) */
 
     gs_flight_state state;
     uint64_t next;             /* next ring index to examine */
@@ -39,21 +39,21 @@ typedef struct {
     double last_t_s;           /* time of the last valid sample, NaN none */
     uint64_t last_idx;
 
-    double up_x, up_y;         /* image direction against gravity (unit) */
+    gs_real up_x, up_y;        /* image direction against gravity (unit) */
     uint32_t up_n;             /* body-axis samples averaged into it */
     bool up_from_flight;       /* set from fitted flights (else body axis or image up) */
 
-    double noise_px;           /* robust COM noise (1 axis), from ground phases; NaN until known */
+    gs_real noise_px;          /* robust COM noise (1 axis), from ground phases; NaN until known */
     float noise_init[9];       /* first |second differences| (NOISE_INIT_N) */
     uint32_t noise_n;
-    double u_hist[3];          /* last three u of valid samples (for a median of 3) */
+    gs_real u_hist[3];         /* last three u of valid samples (for a median of 3) */
     uint64_t i_hist[3];
     double t_hist[3];
     uint32_t n_hist;
 
-    double blk_min_cur, blk_min_prev; /* running minimum of u over the last ~0.5-1 s */
+    gs_real blk_min_cur, blk_min_prev; /* running minimum of u over the last ~0.5-1 s */
     double blk_t0;
-    double peak_u;             /* running maximum once the rise is significant */
+    gs_real peak_u;            /* running maximum once the rise is significant */
     uint64_t peak_idx;
     double peak_t;
 
@@ -61,10 +61,10 @@ typedef struct {
     gs_fit fit;                /* streaming fit of the accepted in-flight samples */
     uint64_t fl_first, fl_last;   /* accepted range so far (absolute ring indices) */
     uint64_t seed_idx;
-    double cusum;              /* one-sided CUSUM of the deviation against gravity */
+    gs_real cusum;             /* one-sided CUSUM of the deviation against gravity */
     uint32_t pend_ok;          /* bit k: pending sample fl_last+1+k is no gross outlier */
     uint32_t outliers_run;     /* consecutive gross outliers */
-    double dt_med_s;           /* typical frame interval */
+    double dt_med_s;           /* typical frame interval (double: frame counts are taken from it) */
 
     float stand_size[GS_STAND_KEEP];
     uint32_t stand_n, stand_next;
@@ -73,8 +73,8 @@ typedef struct {
     double stand_last_t;
     double still_since;        /* start of the current still, upright stretch, NaN none */
 
-    double last_a_px_s2;       /* last accepted acceleration, NaN none */
-    double last_g_dir_deg;
+    gs_real last_a_px_s2;      /* last accepted acceleration, NaN none */
+    gs_real last_g_dir_deg;
     uint32_t n_flights;
 } gs_flight;
 

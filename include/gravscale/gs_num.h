@@ -12,6 +12,13 @@
  * for up to 19 significant digits. */
 bool gs_num_parse(const char *s, size_t len, double *out);
 
+/* The same syntax, but numbers beyond the fast exact cases (more than 19
+ * significant digits, or a decimal exponent beyond +-22 of them) are scaled in
+ * double: within 16 ulp instead of correctly rounded (and a value within 16 ulp
+ * of the largest double may overflow), no multi-precision code. gs_num_parse is this where gs_real is float (the Cortex-M4 build: its
+ * profile values are floats); exposed so that host tests check it. */
+bool gs_num_parse_scaled(const char *s, size_t len, double *out);
+
 /* Parse exactly s[0..len) as a base-10 integer (optional sign). */
 bool gs_num_parse_int(const char *s, size_t len, long *out);
 

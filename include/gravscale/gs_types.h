@@ -6,6 +6,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "gs_math.h"
+
 #define GS_VERSION "0.1.0"
 
 /* The arithmetic of the fits: double on hosts, float on single-precision FPUs
@@ -20,9 +22,9 @@ typedef GS_REAL gs_real;
 /* sqrt and fabs of a gs_real without <tgmath.h> */
 #define GS_SQRT(x) (sizeof(gs_real) < sizeof(double) ? (gs_real)sqrtf((float)(x)) : (gs_real)sqrt((double)(x)))
 #define GS_FABS(x) ((x) < GS_R(0.0) ? -(x) : (x))
-/* cos and sin of a double argument, in float where gs_real is float (no double trig linked) */
-#define GS_COS(x) (sizeof(gs_real) < sizeof(double) ? (double)cosf((float)(x)) : cos((double)(x)))
-#define GS_SIN(x) (sizeof(gs_real) < sizeof(double) ? (double)sinf((float)(x)) : sin((double)(x)))
+/* cos and sin of a double argument, in float where gs_real is float (gs_math.c: no libm trig linked) */
+#define GS_COS(x) (sizeof(gs_real) < sizeof(double) ? (double)gs_cosf((float)(x)) : cos((double)(x)))
+#define GS_SIN(x) (sizeof(gs_real) < sizeof(double) ? (double)gs_sinf((float)(x)) : sin((double)(x)))
 
 typedef enum {
     GS_OK = 0,

@@ -2,7 +2,8 @@
  * newest GS_AGG_MAX accepted flights and a 95 % interval that stays honest
  * from one flight to many. See docs/anthropometry.md ("Aggregate") for the
  * derivation and the Monte Carlo check in tests/test_agg.c.
- * double: runs once per flight on at most GS_AGG_MAX values (no float needed on an M4). */
+ * gs_real (float on an M4): the values are floats and the interval is a statistic;
+ * hosts (double) keep their results. */
 #include <math.h>
 
 #include "gravscale/gs_agg.h"
@@ -10,22 +11,22 @@
 /* With one flight the between-flight scatter cannot be seen; a per-flight
  * relative scatter (pose, size and outlier flights the fit's SE misses) is
  * assumed instead: 3 % of the value, 5 cm at 1.75 m. */
-#define SINGLE_FLIGHT_REL_SPREAD 0.03
+#define SINGLE_FLIGHT_REL_SPREAD GS_R(0.03)
 
-#define MAD_TO_SIGMA 1.4826 /* 1 / Phi^-1(0.75) */
-#define MEDIAN_SE_FACTOR 1.2533 /* sqrt(pi/2): SE(median) / SE(mean), large n, normal data */
+#define MAD_TO_SIGMA GS_R(1.4826) /* 1 / Phi^-1(0.75) */
+#define MEDIAN_SE_FACTOR GS_R(1.2533) /* sqrt(pi/2): SE(median) / SE(mean), large n, normal data */
 
 /* Small-sample correction of the MAD (Croux & Rousseeuw 1992), n = 2..9;
  * n / (n - 0.8) beyond. Values from memory of their table. */
-static const double k_mad_corr[10] = { 0, 0, 1.196, 1.495, 1.363, 1.206, 1.200, 1.140, 1.129, 1.107 };
+static const gs_real k_mad_corr[10] = { 0, 0, 1.196, 1.495, 1.363, 1.206, 1.200, 1.140, 1.129, 1.107 };
 
 /* SE(median) / (sigma / sqrt(n)) for normal data and small n: the median of 2
  * is the mean; exact small-n ratios up to 5, the large-n value beyond. */
-static const double k_median_se[6] = { 1.0, 1.0, 1.0, 1.160, 1.092, 1.197 };
+static const gs_real k_median_se[6] = { 1.0, 1.0, 1.0, 1.160, 1.092, 1.197 };
 
 /* Student-t 97.5 % quantiles by degrees of freedom. */
 static const struct {
-    double dof, q;
+    gs_real dof, q;
 } k_t975[] = {
     { 1, 12.706 }, { 2, 4.303 }, { 3, 3.182 }, { 4, 2.776 }, { 5, 2.571 }, { 6, 2.447 },
     { 7, 2.365 }, { 8, 2.306 }, { 9, 2.262 }, { 10, 2.228 }, { 12, 2.179 }, { 15, 2.131 },
@@ -35,25 +36,25 @@ static const struct {
 
 /* t quantile for a real dof >= 1, linear in 1/dof between table rows (exact
  * at the rows, 1.96 at infinity). */
-static double t975(double dof)
+static gs_real t975(gs_real dof)
 {
-    if (!(dof > 1.0)) {
+    if (!(dof > GS_R(1.0))) {
         return k_t975[0].q;
     }
     for (size_t i = 1; i < N_T975; i++) {
         if (dof <= k_t975[i].dof) {
-            double a = 1.0 / k_t975[i - 1].dof, b = 1.0 / k_t975[i].dof, x = 1.0 / dof;
+            gs_real a = GS_R(1.0) / k_t975[i - 1].dof, b = GS_R(1.0) / k_t975[i].dof, x = GS_R(1.0) / dof;
             return k_t975[i - 1].q + (k_t975[i].q - k_t975[i - 1].q) * (a - x) / (a - b);
         }
     }
-    double b = 1.0 / k_t975[N_T975 - 1].dof;
-    return 1.96 + (k_t975[N_T975 - 1].q - 1.96) * (1.0 / dof) / b;
+    gs_real b = GS_R(1.0) / k_t975[N_T975 - 1].dof;
+    return GS_R(1.96) + (k_t975[N_T975 - 1].q - GS_R(1.96)) * (GS_R(1.0) / dof) / b;
 }
 
-static void sort_asc(double *v, uint32_t n)
+static void sort_asc(gs_real *v, uint32_t n)
 {
     for (uint32_t i = 1; i < n; i++) {
-        double x = v[i];
+        gs_real x = v[i];
         uint32_t j = i;
         while (j > 0 && v[j - 1] > x) {
             v[j] = v[j - 1];
@@ -63,9 +64,9 @@ static void sort_asc(double *v, uint32_t n)
     }
 }
 
-static double median_sorted(const double *v, uint32_t n)
+static gs_real median_sorted(const gs_real *v, uint32_t n)
 {
-    return (n & 1u) ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return (n & 1u) ? v[n / 2] : GS_R(0.5) * (v[n / 2 - 1] + v[n / 2]);
 }
 
 void gs_agg_init(gs_agg *a)
@@ -125,47 +126,47 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         return;
     }
 
-    double v[GS_AGG_MAX], dev[GS_AGG_MAX];
-    double se2_sum = 0.0;
+    gs_real v[GS_AGG_MAX], dev[GS_AGG_MAX];
+    gs_real se2_sum = GS_R(0.0);
     uint32_t n_se = 0;
     for (uint32_t i = 0; i < n; i++) {
         v[i] = a->value[i];
         if (!isnan(a->se[i])) {
-            se2_sum += (double)a->se[i] * (double)a->se[i];
+            se2_sum += (gs_real)a->se[i] * (gs_real)a->se[i];
             n_se++;
         }
     }
     sort_asc(v, n);
-    double med = median_sorted(v, n);
+    gs_real med = median_sorted(v, n);
     out->height_m = med;
-    double rms_se = n_se > 0 ? sqrt(se2_sum / n_se) : (double)NAN;
+    gs_real rms_se = n_se > 0 ? GS_SQRT(se2_sum / n_se) : (gs_real)NAN;
 
-    double half;
+    gs_real half;
     if (n == 1) {
-        double tau = SINGLE_FLIGHT_REL_SPREAD * med;
-        double se = isnan(rms_se) ? 0.0 : rms_se;
-        half = 1.96 * sqrt(se * se + tau * tau);
+        gs_real tau = SINGLE_FLIGHT_REL_SPREAD * med;
+        gs_real se = isnan(rms_se) ? GS_R(0.0) : rms_se;
+        half = GS_R(1.96) * GS_SQRT(se * se + tau * tau);
     } else {
         /* Between-flight spread: MAD, scaled to a normal sigma, small-sample corrected. */
         for (uint32_t i = 0; i < n; i++) {
-            dev[i] = fabs(v[i] - med);
+            dev[i] = GS_FABSR(v[i] - med);
         }
         sort_asc(dev, n);
-        double corr = n < 10 ? k_mad_corr[n] : (double)n / ((double)n - 0.8);
-        double spread = MAD_TO_SIGMA * median_sorted(dev, n) * corr;
+        gs_real corr = n < 10 ? k_mad_corr[n] : (gs_real)n / ((gs_real)n - GS_R(0.8));
+        gs_real spread = MAD_TO_SIGMA * median_sorted(dev, n) * corr;
         /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
-        double se_floor = isnan(rms_se) ? 0.0 : rms_se;
-        double sigma = spread > se_floor ? spread : se_floor;
+        gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
+        gs_real sigma = spread > se_floor ? spread : se_floor;
         /* Satterthwaite: only the part of sigma^2 beyond the known SEs is estimated
          * from the n flights (n-1 dof); all of it known -> normal quantile. */
-        double excess2 = spread * spread - se_floor * se_floor;
-        double q = 1.96;
-        if (excess2 > 0.0) {
-            double s4 = sigma * sigma * sigma * sigma;
-            q = t975((double)(n - 1u) * s4 / (excess2 * excess2));
+        gs_real excess2 = spread * spread - se_floor * se_floor;
+        gs_real q = GS_R(1.96);
+        if (excess2 > GS_R(0.0)) {
+            gs_real s4 = sigma * sigma * sigma * sigma;
+            q = t975((gs_real)(n - 1u) * s4 / (excess2 * excess2));
         }
-        double k = n < 6 ? k_median_se[n] : MEDIAN_SE_FACTOR;
-        half = q * k * sigma / sqrt((double)n);
+        gs_real k = n < 6 ? k_median_se[n] : MEDIAN_SE_FACTOR;
+        half = q * k * sigma / GS_SQRT((gs_real)n);
     }
     if (isfinite(half)) {
         out->ci95_lo_m = med - half;

@@ -126,7 +126,7 @@ static float angle_deg(vec2 a, vec2 b, vec2 c)
     }
     float cs = v_dot(u, v) / (lu * lv);
     cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
-    return acosf(cs) * RAD_TO_DEG;
+    return GS_ACOSF(cs) * RAD_TO_DEG;
 }
 
 /* 0 at x0, 1 at x1 (either order), linear and clamped between. */
@@ -460,7 +460,7 @@ static float upright_score(const frame *f, bool have_trunk, vec2 s, vec2 p, bool
     if (axis_from_body && trunk_len > 0.0f) {
         float cs = v_dot(v_sub(s, p), up) / trunk_len;
         cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
-        other = min_nan(other, ramp(acosf(cs) * RAD_TO_DEG, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1));
+        other = min_nan(other, ramp(GS_ACOSF(cs) * RAD_TO_DEG, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1));
     }
     return min_nan(knee, other);
 }

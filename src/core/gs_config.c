@@ -434,7 +434,7 @@ double gs_gravity_m_s2(double latitude_deg, double altitude_m)
     /* float where double is emulated: g to 1e-7 is 100x finer than any site needs */
     double s = GS_SIN(latitude_deg * (pi / 180.0));
     double s2 = s * s;
-    double g0 = 9.7803253359 * (1.0 + 0.00193185265241 * s2) / sqrt(1.0 - 0.00669437999013 * s2);
+    double g0 = 9.7803253359 * (1.0 + 0.00193185265241 * s2) / GS_SQRT(1.0 - 0.00669437999013 * s2);
     return g0 - 3.086e-6 * altitude_m;
 }
 

@@ -55,7 +55,7 @@ static int rix(int i, int j)
     return base[i] + (j - i);
 }
 
-void gs_fit_add(gs_fit *f, double t_s, double x_px, double y_px, double w)
+void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
 {
     gs_real v[3], bx, by, sw, tau;
     int k, j;
@@ -145,26 +145,27 @@ gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
     ts = (gs_real)f->tscale_s;
     ts2 = ts * ts;
     {
-        /* the results leave as double (the public form), computed in gs_real */
+        /* the results are gs_real too (gs_fit_result); only t0_s is double */
         gs_real ax = GS_R(2.0) * cx[2] / ts2, ay = GS_R(2.0) * cy[2] / ts2;
-        out->x0_px = (double)cx[0];
-        out->vx_px_s = (double)(cx[1] / ts);
-        out->ax_px_s2 = (double)ax;
-        out->y0_px = (double)cy[0];
-        out->vy_px_s = (double)(cy[1] / ts);
-        out->ay_px_s2 = (double)ay;
-        out->a_px_s2 = (double)sqrt(ax * ax + ay * ay);
-        out->g_dir_deg = (double)(atan2(ax, ay) * rad_to_deg);
+        out->x0_px = (gs_real)cx[0];
+        out->vx_px_s = (gs_real)(cx[1] / ts);
+        out->ax_px_s2 = (gs_real)ax;
+        out->y0_px = (gs_real)cy[0];
+        out->vy_px_s = (gs_real)(cy[1] / ts);
+        out->ay_px_s2 = (gs_real)ay;
+        out->a_px_s2 = (gs_real)sqrt(ax * ax + ay * ay);
+        out->g_dir_deg = GS_REAL_IS_FLOAT ? (gs_real)(gs_atan2f((float)ax, (float)ay) * (float)rad_to_deg)
+                                         : (gs_real)(atan2(ax, ay) * rad_to_deg);
     }
     ssr = f->ssr_x + f->ssr_y;
-    out->rms_px = (double)sqrt(ssr / f->sum_w);
+    out->rms_px = (gs_real)sqrt(ssr / f->sum_w);
     if (f->n > 3) {
         /* Pooled over both axes: 2n residuals, 6 coefficients. */
         gs_real sigma2 = ssr / (GS_R(2.0) * ((gs_real)f->n - GS_R(3.0)));
         /* Row 2 of R^-1 is (0, 0, 1/r22), so [(R^T R)^-1]_22 = 1/r22^2. */
         gs_real se_c2 = sqrt(sigma2) / fabs(f->r[5]);
         /* var(ax) = var(ay), so the magnitude's variance is the same. */
-        out->a_se_px_s2 = (double)(GS_R(2.0) * se_c2 / ts2);
+        out->a_se_px_s2 = GS_R(2.0) * se_c2 / ts2;
     }
     return GS_OK;
 }

@@ -9,21 +9,26 @@
  * the boundary) and the final robust 2D fit uses only samples in free flight.
  *
  * float vs double (the Cortex-M4's FPU is single precision; double is emulated):
- * what runs per sample inside the fits and per boundary candidate is gs_real
- * (float there: test_sample, pred_var_factor, piecewise_ssr, solve_spd, and all
- * of gs_fit.c). What stays double, and why:
+ * the per-frame state machine (u, noise, levels, CUSUM, sizes), the per-sample
+ * and per-boundary-candidate work (test_sample, pred_var_factor, piecewise_ssr,
+ * solve_spd, all of gs_fit.c) and closing a flight (apex, SE, q, height) are
+ * gs_real: float on the M4, double on hosts (bit-identical to the all-double
+ * code). What stays double, and why:
  *  - absolute times (t_s, T0, T1, last_t_s, peak_t, blk_t0, still_since, ...):
  *    a stream runs for days and float seconds lose milliseconds after hours;
- *  - the per-frame state machine (u, noise, levels, thresholds): a few dozen
- *    operations a frame, kept double so hosts keep their exact results;
- *  - closing a flight (event fields, SE, apex, jump height): once per flight,
- *    and the event's public fields are double. */
+ *  - time differences compared with time thresholds (gaps, latency, settling)
+ *    and the frame interval (dt_med_s) with the frame counts taken from it by
+ *    ceil (core width, boundary grid steps, speed lag): these are knife edges
+ *    (a ratio of exactly 6 frames rounds up or not); in float they flipped
+ *    differently from the host's double on a tenth of a held-out set's
+ *    flights, in double they decide as on the host;
+ *  - the event's public fields (double). */
 #include "gravscale/gs_flight.h"
 
 #include <math.h>
 #include <string.h>
 
-#define GS_PI 3.14159265358979323846
+#define GS_PI GS_R(3.14159265358979323846)
 
 #ifdef GS_FLIGHT_DEBUG
 #include <stdio.h>
@@ -32,32 +37,41 @@
 #define DBG(...) ((void)0)
 #endif
 
+/* ceil(x) of a double: libm's where gs_real is double, else the same value without
+ * libm (only of finite |x| < 2^62: frame counts) */
+#define CEIL_D(x) (GS_REAL_IS_FLOAT ? ceil_d(x) : ceil(x))
+static double ceil_d(double x)
+{
+    double t = (double)(long long)x;  /* toward zero, exact */
+    return t < x ? t + 1.0 : t;
+}
+
 /* tuning: thresholds in units of the noise or of the object's size */
 #define USABLE_W_MIN     0.05f  /* lighter frames are left out of flight detection */
-#define SEED_RISE_REL    0.03   /* apex must rise this x size above the recent minimum */
-#define SEED_RISE_NOISE  8.0    /* ... and this x noise */
-#define SEED_DROP_NOISE  2.5    /* apex confirmed once u fell this x noise below it */
-#define CORE_HALF_S      0.07   /* half-width of the seed's core window */
-#define CUSUM_K          1.3    /* CUSUM reference: deviations below k sigma drain it */
-#define CUSUM_H          5.0    /* CUSUM alarm: contact */
-#define VERIFY_RMS       2.5    /* ... and only when the refit's residual is near the noise */
-#define VERIFY_Z         2.0    /* after a refit through an alarm, edge samples below this: false alarm */
-#define CUSUM_ZMAX       6.0    /* one sample adds at most this (a lone glitch cannot end a flight) */
-#define BOUNDARY_IN_S    0.025  /* boundary search reaches this far (at least a frame) inside the grown flight */
-#define GROSS_OUTLIER    7.0    /* perpendicular or downward deviation = bad keypoints, skipped */
-#define CONTACT_MIN_G    0.5    /* contact force past a boundary: at least half of g */
-#define DROP_PENALTY     4.0    /* SSR gain (x sigma^2) needed to drop a sample the online test kept */
-#define TAKEOFF_MAX_G    4.0    /* contact force past take-off: (push-off + g) at most 4 g */
-#define LANDING_MAX_G    30.0   /* ... and past landing (impacts are harder) */
+#define SEED_RISE_REL    GS_R(0.03)   /* apex must rise this x size above the recent minimum */
+#define SEED_RISE_NOISE  GS_R(8.0)    /* ... and this x noise */
+#define SEED_DROP_NOISE  GS_R(2.5)    /* apex confirmed once u fell this x noise below it */
+#define CORE_HALF_S      0.07         /* half-width of the seed's core window */
+#define CUSUM_K          GS_R(1.3)    /* CUSUM reference: deviations below k sigma drain it */
+#define CUSUM_H          GS_R(5.0)    /* CUSUM alarm: contact */
+#define VERIFY_RMS       GS_R(2.5)    /* ... and only when the refit's residual is near the noise */
+#define VERIFY_Z         GS_R(2.0)    /* after a refit through an alarm, edge samples below this: false alarm */
+#define CUSUM_ZMAX       GS_R(6.0)    /* one sample adds at most this (a lone glitch cannot end a flight) */
+#define BOUNDARY_IN_S    0.025        /* boundary search reaches this far (at least a frame) inside the grown flight */
+#define GROSS_OUTLIER    GS_R(7.0)    /* perpendicular or downward deviation = bad keypoints, skipped */
+#define CONTACT_MIN_G    GS_R(0.5)    /* contact force past a boundary: at least half of g */
+#define DROP_PENALTY     GS_R(4.0)    /* SSR gain (x sigma^2) needed to drop a sample the online test kept */
+#define TAKEOFF_MAX_G    GS_R(4.0)    /* contact force past take-off: (push-off + g) at most 4 g */
+#define LANDING_MAX_G    GS_R(30.0)   /* ... and past landing (impacts are harder) */
 #define CONTACT_SAMPLES_MAX 4   /* contact samples past each boundary seen by the piecewise model */
 #define BOUNDARY_STEPS   4      /* grid points per frame interval for sub-frame boundaries */
-#define STAND_SPEED_REL  0.25   /* standing: |du/dt| below this x size per second */
-#define STAND_UPRIGHT    0.7
-#define LOOSE_UPRIGHT    0.5    /* fallback size samples (no settled stance seen yet) */
+#define STAND_SPEED_REL  GS_R(0.25)   /* standing: |du/dt| below this x size per second */
+#define STAND_UPRIGHT    GS_R(0.7)
+#define LOOSE_UPRIGHT    GS_R(0.5)    /* fallback size samples (no settled stance seen yet) */
 #define MEDIAN_MAX       64     /* largest set a median is taken of */
 #define NOISE_INIT_N     9      /* second differences whose median starts the noise estimate */
-#define STAND_SETTLE_S   0.2    /* still this long before a frame counts as standing */
-#define EMIT_FACTOR      2.0    /* candidates implying a size beyond [min/2, max*2] are not flights */
+#define STAND_SETTLE_S   0.2          /* still this long before a frame counts as standing */
+#define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
@@ -87,9 +101,9 @@ static bool usable_at(const gs_flight *f, uint64_t i)
     return usable(at(f, i, &b));
 }
 
-static double u_of(const gs_flight *f, const gs_sample_full *s)
+static gs_real u_of(const gs_flight *f, const gs_sample_full *s)
 {
-    return (double)s->x_px * f->up_x + (double)s->y_px * f->up_y;
+    return (gs_real)s->x_px * f->up_x + (gs_real)s->y_px * f->up_y;
 }
 
 static void emit(const gs_flight *f, const gs_event *ev)
@@ -140,7 +154,7 @@ static void trace_fit(const gs_flight *f, const char *purpose, double t0, double
 }
 
 /* small sorts for medians of bounded arrays */
-static double median_f(float *v, uint32_t n)
+static gs_real median_f(float *v, uint32_t n)
 {
     if (n == 0) return NAN;
     for (uint32_t i = 1; i < n; i++) {
@@ -149,12 +163,12 @@ static double median_f(float *v, uint32_t n)
         while (j > 0 && v[j - 1] > x) { v[j] = v[j - 1]; j--; }
         v[j] = x;
     }
-    return (n & 1u) ? (double)v[n / 2] : 0.5 * ((double)v[n / 2 - 1] + (double)v[n / 2]);
+    return (n & 1u) ? (gs_real)v[n / 2] : GS_R(0.5) * ((gs_real)v[n / 2 - 1] + (gs_real)v[n / 2]);
 }
 
-static double med3(double a, double b, double c)
+static gs_real med3(gs_real a, gs_real b, gs_real c)
 {
-    if (a > b) { double t = a; a = b; b = t; }
+    if (a > b) { gs_real t = a; a = b; b = t; }
     if (b > c) { b = c; }
     return a > b ? a : b;
 }
@@ -175,8 +189,8 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->next = gs_ring_head(ring);
     f->quiet_from = f->next;
     f->last_t_s = NAN;
-    f->up_x = 0.0;
-    f->up_y = -1.0;  /* image up until the body axis or a flight says otherwise */
+    f->up_x = GS_R(0.0);
+    f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
     f->noise_px = NAN;
     f->blk_min_cur = INFINITY;
     f->blk_min_prev = INFINITY;
@@ -192,18 +206,18 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
 
 /* ---- per-flight helpers ---------------------------------------------------- */
 
-static double noise_floor(const gs_flight *f)
+static gs_real noise_floor(const gs_flight *f)
 {
-    double n = isfinite(f->noise_px) ? f->noise_px : 1.0;
-    return n > 0.05 ? n : 0.05;
+    gs_real n = isfinite(f->noise_px) ? f->noise_px : GS_R(1.0);
+    return n > GS_R(0.05) ? n : GS_R(0.05);
 }
 
 /* sigma of one axis from the running fit, at least the ground noise */
-static double fit_sigma(const gs_flight *f, const gs_fit_result *r)
+static gs_real fit_sigma(const gs_flight *f, const gs_fit_result *r)
 {
-    double s = noise_floor(f);
+    gs_real s = noise_floor(f);
     if (r->n >= 8 && isfinite(r->rms_px)) {
-        double sf = r->rms_px / sqrt(2.0) * sqrt((double)r->n / (double)(r->n - 3));
+        gs_real sf = r->rms_px / GS_SQRT(GS_R(2.0)) * GS_SQRT((gs_real)r->n / (gs_real)(r->n - 3));
         if (sf > s) s = sf;
     }
     return s;
@@ -227,7 +241,7 @@ static gs_real pred_var_factor(const gs_fit *fit, double t_s)
  * the deviation against gravity in units of its standard deviation (contact
  * pushes the body above the parabola, so z grows quadratically after it). */
 static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
-                        const gs_sample_full *s, double *z)
+                        const gs_sample_full *s, gs_real *z)
 {
     /* per sample and per boundary candidate: gs_real; only the time difference is double */
     gs_real dt = (gs_real)(s->t_s - r->t0_s);
@@ -242,16 +256,16 @@ static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_resu
     gs_real sig = (gs_real)fit_sigma(f, r);
     gs_real vf = pred_var_factor(fit, s->t_s);
     gs_real tot = sig * GS_SQRT(GS_R(1.0) + (isfinite(vf) ? vf : GS_R(1e6)));
-    *z = (double)(up / tot);
+    *z = (gs_real)(up / tot);
     return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
 }
 
 /* one-sided CUSUM of z: contact raises it, noise drains it */
-static double cusum_step(double S, double z)
+static gs_real cusum_step(gs_real S, gs_real z)
 {
     if (z > CUSUM_ZMAX) z = CUSUM_ZMAX;
     S += z - CUSUM_K;
-    return S > 0.0 ? S : 0.0;
+    return S > GS_R(0.0) ? S : GS_R(0.0);
 }
 
 /* typical frame interval from the history (for time-based spans) */
@@ -260,27 +274,27 @@ static double frame_dt(const gs_flight *f)
     return (isfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
 }
 
-static double stand_size(const gs_flight *f, double *se_out);
+static gs_real stand_size(const gs_flight *f, gs_real *se_out);
 
 /* Could this fit be free fall? Acceleration roughly along the expected gravity
  * direction, and of a size that makes the object's size plausible (loosely:
  * this gates candidates, the final checks are stricter). */
-static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double size_px)
+static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real size_px)
 {
-    if (!(r->a_px_s2 > 0.0)) return false;
+    if (!(r->a_px_s2 > GS_R(0.0))) return false;
     /* a fit of few noisy samples gets the benefit of two standard errors */
-    double rel_se = (isfinite(r->a_se_px_s2) && r->a_se_px_s2 > 0.0) ? r->a_se_px_s2 / r->a_px_s2 : 0.0;
-    double cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
-    double max_ang = f->up_from_flight ? 25.0 : (f->up_n > 0 ? 40.0 : 60.0);
-    max_ang += 2.0 * rel_se * 180.0 / GS_PI;
-    if (max_ang > 80.0) max_ang = 80.0;
+    gs_real rel_se = (isfinite(r->a_se_px_s2) && r->a_se_px_s2 > GS_R(0.0)) ? r->a_se_px_s2 / r->a_px_s2 : GS_R(0.0);
+    gs_real cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
+    gs_real max_ang = f->up_from_flight ? GS_R(25.0) : (f->up_n > 0 ? GS_R(40.0) : GS_R(60.0));
+    max_ang += GS_R(2.0) * rel_se * GS_R(180.0) / GS_PI;
+    if (max_ang > GS_R(80.0)) max_ang = GS_R(80.0);
     /* a threshold: single precision is plenty where double is emulated */
-    if (!(cosang > GS_COS(max_ang * GS_PI / 180.0))) return false;
-    double a_hi = r->a_px_s2 + 2.0 * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - 2.0 * rel_se * r->a_px_s2;
-    if (isfinite(size_px) && size_px > 0.0) {
+    if (!(cosang > (gs_real)GS_COS(max_ang * GS_PI / GS_R(180.0)))) return false;
+    gs_real a_hi = r->a_px_s2 + GS_R(2.0) * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - GS_R(2.0) * rel_se * r->a_px_s2;
+    if (isfinite(size_px) && size_px > GS_R(0.0)) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
-        double a_min = size_px * f->g_m_s2 / ((double)f->cfg->size_max_m * EMIT_FACTOR);
-        double a_max = size_px * f->g_m_s2 / ((double)f->cfg->size_min_m / EMIT_FACTOR);
+        gs_real a_min = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_max_m * EMIT_FACTOR);
+        gs_real a_max = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_min_m / EMIT_FACTOR);
         if (a_hi < a_min || a_lo > a_max) return false;
     } else if (isfinite(f->last_a_px_s2)) {
         if (a_hi < f->last_a_px_s2 / EMIT_FACTOR || a_lo > f->last_a_px_s2 * EMIT_FACTOR) return false;
@@ -289,14 +303,14 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, double si
 }
 
 /* the object's size in px for gating: standing stature, or the rigid object's latest size */
-static double gate_size(const gs_flight *f, uint64_t idx)
+static gs_real gate_size(const gs_flight *f, uint64_t idx)
 {
     if (f->rigid) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
-        return s && isfinite(s->size_px) ? (double)s->size_px : NAN;
+        return s && isfinite(s->size_px) ? (gs_real)s->size_px : NAN;
     }
-    double se;
+    gs_real se;
     return stand_size(f, &se);
 }
 
@@ -331,12 +345,12 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     gs_fit_result r;
     if (gs_fit_solve(&f->fit, &r) != GS_OK) return false;
     /* a refit that only fits with a residual far above the noise proves nothing */
-    if (r.rms_px / sqrt(2.0) > VERIFY_RMS * noise_floor(f)) return false;
+    if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        double z;
+        gs_real z;
         if (usable(s)) {
             if (test_sample(f, &f->fit, &r, s, &z)) {
                 if (z > VERIFY_Z) return false;
@@ -351,7 +365,7 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
 static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double half_s)
 {
     double dt = frame_dt(f);
-    uint32_t half = (uint32_t)ceil(half_s / dt - 1e-9);
+    uint32_t half = (uint32_t)CEIL_D(half_s / dt - 1e-9);
     if (half < 2) half = 2;
     uint64_t lo = apex >= f->quiet_from + half ? apex - half : f->quiet_from;
     uint64_t hi = apex + half < newest ? apex + half : newest;
@@ -378,7 +392,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     f->fl_first = lo;
     f->fl_last = hi;
     f->seed_idx = apex;
-    f->cusum = 0.0;
+    f->cusum = GS_R(0.0);
     f->pend_ok = 0;
     f->outliers_run = 0;
     return true;
@@ -431,12 +445,12 @@ static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
  * boundary placed inside the flight could absorb flight samples for free. */
-static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double tc, double ts,
-                            double T, int side, double alpha_min_px, double alpha_max_px,
+static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double tc, double ts,
+                            double T, int side, gs_real alpha_min_px, gs_real alpha_max_px,
                             const gs_fit_result *r)
 {
     /* called per boundary candidate and sample: gs_real. In float, u is taken about
-     * the first sample's (the SSR below is yy - c.b, which cancels), in double as is */
+     * the first sample's (the SSR below is yy - c.b, which cancels), in gs_real as is */
     gs_real A[4][4] = {{0}}, b[4] = {0}, yy = GS_R(0.0);
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
@@ -444,7 +458,7 @@ static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        double z;
+        gs_real z;
         if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
         gs_real w = (gs_real)s->w;
         gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
@@ -460,12 +474,13 @@ static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double
         yy += w * u * u;
     }
     gs_real c[4];
-    gs_real c3_min = (gs_real)(alpha_min_px * ts * ts), c3_max = (gs_real)(alpha_max_px * ts * ts);  /* alpha in tau units */
+    gs_real tsr = (gs_real)ts;
+    gs_real c3_min = alpha_min_px * tsr * tsr, c3_max = alpha_max_px * tsr * tsr;  /* alpha in tau units */
     bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
     if (solved && c[3] >= c3_min && c[3] <= c3_max) {
         gs_real ssr = yy;
         for (int k = 0; k < 4; k++) ssr -= c[k] * b[k];
-        return ssr > GS_R(0.0) ? (double)ssr : 0.0;
+        return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
     }
     /* alpha at a bound: fit the parabola to u - alpha h */
     gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
@@ -475,13 +490,13 @@ static double piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double
     if (!solve_spd(A, b3, 3, c)) return INFINITY;
     gs_real ssr = yy3;
     for (int k = 0; k < 3; k++) ssr -= c[k] * b3[k];
-    return ssr > GS_R(0.0) ? (double)ssr : 0.0;
+    return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
 }
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples. */
 static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
-                              uint64_t edge_in, uint64_t edge_out, double alpha_min_px,
-                              double alpha_max_px, double t_grown, double penalty,
+                              uint64_t edge_in, uint64_t edge_out, gs_real alpha_min_px,
+                              gs_real alpha_max_px, double t_grown, gs_real penalty,
                               const gs_fit_result *r)
 {
     gs_sample_full a_b, b_b;
@@ -496,16 +511,17 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
     double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
     double t_from = eo->t_s, t_to = ei->t_s + (side < 0 ? inside : -inside);
     if (side > 0) { double tmp = t_from; t_from = t_to; t_to = tmp; }
-    int steps = (int)ceil((t_to - t_from) / dt * BOUNDARY_STEPS);
+    int steps = (int)CEIL_D((t_to - t_from) / dt * BOUNDARY_STEPS);
     if (steps < 1) steps = 1;
     if (steps > 400) steps = 400;
-    double best = INFINITY, best_T = NAN;
+    gs_real best = INFINITY;
+    double best_T = NAN;
     for (int k = 0; k <= steps; k++) {
         double T = t_from + (t_to - t_from) * (double)k / (double)steps;
-        double ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
+        gs_real ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
         /* dropping samples the online test took as flight must pay for itself */
         if ((side < 0 && T > t_grown) || (side > 0 && T < t_grown)) ssr += penalty;
-        if (ssr < best - 1e-12) { best = ssr; best_T = T; }
+        if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
 }
@@ -513,15 +529,15 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
 /* ---- closing a candidate ---------------------------------------------------- */
 
 /* median of n <= MEDIAN_MAX values and its standard error (from the MAD) */
-static double median_se(const float *v, uint32_t n, double *se_out)
+static gs_real median_se(const float *v, uint32_t n, gs_real *se_out)
 {
     float tmp[MEDIAN_MAX], dev[MEDIAN_MAX];
     if (n > MEDIAN_MAX) n = MEDIAN_MAX;
     for (uint32_t i = 0; i < n; i++) tmp[i] = v[i];
-    double med = median_f(tmp, n);
+    gs_real med = median_f(tmp, n);
     if (n >= 2) {
-        for (uint32_t i = 0; i < n; i++) dev[i] = (float)fabs((double)tmp[i] - med);
-        *se_out = 1.2533 * median_f(dev, n) * 1.4826 / sqrt((double)n);
+        for (uint32_t i = 0; i < n; i++) dev[i] = (float)GS_FABSR((gs_real)tmp[i] - med);
+        *se_out = GS_R(1.2533) * median_f(dev, n) * GS_R(1.4826) / GS_SQRT((gs_real)n);
     } else {
         *se_out = NAN;
     }
@@ -530,7 +546,7 @@ static double median_se(const float *v, uint32_t n, double *se_out)
 
 /* standing size: settled upright frames, else (no stance seen yet) still frames that are
  * roughly upright */
-static double stand_size(const gs_flight *f, double *se_out)
+static gs_real stand_size(const gs_flight *f, gs_real *se_out)
 {
     if (f->stand_n >= 3) return median_se(f->stand_size, f->stand_n, se_out);
     if (f->loose_n >= 3) return median_se(f->loose_size, f->loose_n, se_out);
@@ -538,7 +554,7 @@ static double stand_size(const gs_flight *f, double *se_out)
     return NAN;
 }
 
-static double rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, double *se_out)
+static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real *se_out)
 {
     float v[MEDIAN_MAX];
     uint32_t n = 0;
@@ -560,7 +576,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     uint64_t alarm = UINT64_MAX;
     double max_gap = (double)f->cfg->max_gap_s;
     uint32_t outl = 0;
-    double S = 0.0;
+    gs_real S = GS_R(0.0);
     uint64_t oldest = gs_ring_oldest(f->ring);
     uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
     gs_sample_full first_b;
@@ -579,7 +595,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         if (t_prev - s->t_s > max_gap) break;
         if (sd && sd->t_s - s->t_s > (double)f->cfg->max_flight_s) break;
         t_prev = s->t_s;
-        double z;
+        gs_real z;
         if (!test_sample(f, &f->fit, r, s, &z)) {
             if (++outl > 2) break;
             continue;
@@ -590,7 +606,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
             if (alarm_is_false(f, i, f->fl_last, i, -1)) {
                 clean = i;
                 f->fl_first = i;
-                S = 0.0;
+                S = GS_R(0.0);
                 gs_fit_solve(&f->fit, r);
                 continue;
             }
@@ -599,7 +615,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         }
         gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
         gs_fit_solve(&f->fit, r);
-        if (S == 0.0) clean = i;
+        if (S == GS_R(0.0)) clean = i;
     }
     if (clean != f->fl_first || alarm != UINT64_MAX) {
         f->fl_first = clean;
@@ -620,7 +636,7 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
     uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
     uint64_t head = gs_ring_head(f->ring);
     uint32_t n = 0;
-    double z_prev = -INFINITY;
+    gs_real z_prev = -INFINITY;
     uint64_t i = edge;
     *outer = edge;
     *first = edge;
@@ -630,7 +646,7 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         if (!usable(s)) continue;
-        double z;
+        gs_real z;
         if (!test_sample(f, &f->fit, r, s, &z)) continue;  /* a glitch: look past it */
         if (n > 0 && !(z > z_prev)) break;
         if (n == 0) *first = i;
@@ -652,8 +668,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     uint64_t left_alarm = grow_left(f, &r);
 
     /* boundary refinement on the up direction of the flight's own acceleration */
-    double save_ux = f->up_x, save_uy = f->up_y;
-    if (isfinite(r.a_px_s2) && r.a_px_s2 > 0.0) {
+    gs_real save_ux = f->up_x, save_uy = f->up_y;
+    if (isfinite(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
         f->up_x = -r.ax_px_s2 / r.a_px_s2;
         f->up_y = -r.ay_px_s2 / r.a_px_s2;
     }
@@ -669,9 +685,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     /* a flight longer than the ring holds has lost its edges: no refinement */
     if (!held(f, L) || !held(f, R) || !held(f, lo) || !held(f, hi) || !held(f, first_left) || !held(f, first_right))
         n_left = n_right = 0;
-    double amin = CONTACT_MIN_G * r.a_px_s2;
-    double sig = fit_sigma(f, &r);
-    double pen = DROP_PENALTY * sig * sig;
+    gs_real amin = CONTACT_MIN_G * r.a_px_s2;
+    gs_real sig = fit_sigma(f, &r);
+    gs_real pen = DROP_PENALTY * sig * sig;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n_left >= 2)
@@ -715,7 +731,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
-    double max_gap_in = 0.0, t_prev = NAN;
+    double max_gap_in = 0.0;
+    double t_prev = NAN;
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
@@ -748,48 +765,50 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     j->accepted = false;
     j->reason = GS_REJ_NONE;
 
-    double size_se = NAN;
-    double size = f->rigid ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
+    gs_real size_se = NAN;
+    gs_real size = f->rigid ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
 
     if (st != GS_OK) {
         goto done;  /* nothing fits: not a flight worth reporting */
     } else {
-        double g = f->g_m_s2;
+        gs_real g = f->g_m_s2;
         j->a_px_s2 = fr.a_px_s2;
         j->a_px_se_s2 = fr.a_se_px_s2;
         j->g_dir_deg = fr.g_dir_deg;
         j->rms_px = fr.rms_px;
-        j->q_m_per_px = g / fr.a_px_s2;
+        gs_real q = g / fr.a_px_s2, height = NAN;
+        j->q_m_per_px = q;
         /* apex: where the velocity along gravity is zero */
-        double gx = fr.ax_px_s2 / fr.a_px_s2, gy = fr.ay_px_s2 / fr.a_px_s2;
-        double v_down = fr.vx_px_s * gx + fr.vy_px_s * gy;
+        gs_real gx = fr.ax_px_s2 / fr.a_px_s2, gy = fr.ay_px_s2 / fr.a_px_s2;
+        gs_real v_down = fr.vx_px_s * gx + fr.vy_px_s * gy;
         j->t_apex_s = fr.t0_s - v_down / fr.a_px_s2;
-        double rise_t = j->t_apex_s - T0;
-        j->jump_height_m = 0.5 * g * rise_t * rise_t;
+        gs_real rise_t = j->t_apex_s - T0;
+        j->jump_height_m = GS_R(0.5) * g * rise_t * rise_t;
         j->takeoff_velocity_m_s = g * rise_t;
         if (isfinite(size)) {
-            j->height_m = size * j->q_m_per_px;
-            double ra = fr.a_se_px_s2 / fr.a_px_s2;
-            double rs = isfinite(size_se) ? size_se / size : 0.0;
-            j->height_se_m = j->height_m * sqrt((isfinite(ra) ? ra * ra : 0.0) + rs * rs);
+            height = size * q;
+            j->height_m = height;
+            gs_real ra = fr.a_se_px_s2 / fr.a_px_s2;
+            gs_real rs = isfinite(size_se) ? size_se / size : GS_R(0.0);
+            j->height_se_m = height * GS_SQRT((isfinite(ra) ? ra * ra : GS_R(0.0)) + rs * rs);
         }
 
         /* is this a flight at all? (walking bumps, standing, noise) */
         bool flight_like = plausible_fall(f, &fr, size);
         if (!flight_like) goto done;
 
-        if (n_in < f->cfg->min_samples || j->flight_time_s < (double)f->cfg->min_flight_s)
+        if (n_in < f->cfg->min_samples || (gs_real)j->flight_time_s < (gs_real)f->cfg->min_flight_s)
             j->reason = GS_REJ_FEW_SAMPLES;
         else if (max_gap_in > (double)f->cfg->max_gap_s)
             j->reason = GS_REJ_GAP;
         else if (!isfinite(size))
             j->reason = GS_REJ_NO_SIZE;
-        else if (fr.rms_px > (double)f->cfg->max_rms_rel * size)
+        else if (fr.rms_px > (gs_real)f->cfg->max_rms_rel * size)
             j->reason = GS_REJ_LARGE_RESIDUAL;
-        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (double)f->cfg->max_a_se_rel))
+        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)f->cfg->max_a_se_rel))
             j->reason = GS_REJ_UNCERTAIN_A;
-        else if (j->height_m < (double)f->cfg->size_min_m || j->height_m > (double)f->cfg->size_max_m)
+        else if (height < (gs_real)f->cfg->size_min_m || height > (gs_real)f->cfg->size_max_m)
             j->reason = GS_REJ_IMPLAUSIBLE_A;
         j->accepted = j->reason == GS_REJ_NONE;
 
@@ -797,22 +816,22 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
         if (truncated) j->warnings |= GS_WARN_CLIPPED;
         if (f->n_flights > 0 && isfinite(f->last_g_dir_deg) &&
-            fabs(fr.g_dir_deg - f->last_g_dir_deg) > 10.0)
+            GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
             j->warnings |= GS_WARN_GRAVITY_TILT;
     }
 
     if (j->accepted) {
         f->last_a_px_s2 = fr.a_px_s2;
         f->last_g_dir_deg = isfinite(f->last_g_dir_deg)
-            ? 0.7 * f->last_g_dir_deg + 0.3 * fr.g_dir_deg : fr.g_dir_deg;
+            ? GS_R(0.7) * f->last_g_dir_deg + GS_R(0.3) * fr.g_dir_deg : fr.g_dir_deg;
         /* gravity's direction in the image, from the flights themselves */
-        double ux = -fr.ax_px_s2 / fr.a_px_s2, uy = -fr.ay_px_s2 / fr.a_px_s2;
+        gs_real ux = -fr.ax_px_s2 / fr.a_px_s2, uy = -fr.ay_px_s2 / fr.a_px_s2;
         if (f->up_from_flight) {
-            ux = 0.7 * f->up_x + 0.3 * ux;
-            uy = 0.7 * f->up_y + 0.3 * uy;
+            ux = GS_R(0.7) * f->up_x + GS_R(0.3) * ux;
+            uy = GS_R(0.7) * f->up_y + GS_R(0.3) * uy;
         }
-        double nrm = sqrt(ux * ux + uy * uy);
-        if (nrm > 0.0) { f->up_x = ux / nrm; f->up_y = uy / nrm; f->up_from_flight = true; }
+        gs_real nrm = GS_SQRT(ux * ux + uy * uy);
+        if (nrm > GS_R(0.0)) { f->up_x = ux / nrm; f->up_y = uy / nrm; f->up_from_flight = true; }
     }
     f->n_flights++;
     emit(f, &ev);
@@ -826,7 +845,7 @@ done:
         /* next seeds start after the landing: restart the level trackers */
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, newest, &s_b);
-        double u = s ? u_of(f, s) : NAN;
+        gs_real u = s ? u_of(f, s) : NAN;
         f->blk_min_cur = isfinite(u) ? u : INFINITY;
         f->blk_min_prev = f->blk_min_cur;
         f->blk_t0 = s ? s->t_s : NAN;
@@ -840,23 +859,23 @@ done:
 static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s);
 
 /* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
-static double speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, double u)
+static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u)
 {
-    uint64_t k = (uint64_t)ceil(0.1 / frame_dt(f));
+    uint64_t k = (uint64_t)CEIL_D(0.1 / frame_dt(f));
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
     const gs_sample_full *b = at(f, idx - k, &b_b);
     if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
-    return fabs(u - u_of(f, b)) / (s->t_s - b->t_s);
+    return GS_FABSR(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
 }
 
-static void update_standing(gs_flight *f, const gs_sample_full *s, double speed)
+static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed)
 {
     if (!isfinite(speed)) return;
     if (f->rigid || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
-    if (!(speed < STAND_SPEED_REL * (double)s->size_px)) { f->still_since = NAN; return; }
+    if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
     if (!isfinite(f->still_since)) f->still_since = s->t_s;
     if (s->upright >= LOOSE_UPRIGHT) {
         f->loose_size[f->loose_next] = s->size_px;
@@ -871,12 +890,12 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, double speed)
     f->stand_last_t = s->t_s;
     /* body axis -> image up, until flights measure gravity directly */
     if (!f->up_from_flight && isfinite(s->up_x) && isfinite(s->up_y)) {
-        double kw = f->up_n < 20 ? 1.0 / (double)(f->up_n + 1) : 0.05;
-        double ux = (1.0 - kw) * f->up_x + kw * (double)s->up_x;
-        double uy = (1.0 - kw) * f->up_y + kw * (double)s->up_y;
+        gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
+        gs_real ux = (GS_R(1.0) - kw) * f->up_x + kw * (gs_real)s->up_x;
+        gs_real uy = (GS_R(1.0) - kw) * f->up_y + kw * (gs_real)s->up_y;
         if (f->up_n == 0) { ux = s->up_x; uy = s->up_y; }
-        double nrm = sqrt(ux * ux + uy * uy);
-        if (nrm > 0.0) { f->up_x = ux / nrm; f->up_y = uy / nrm; }
+        gs_real nrm = GS_SQRT(ux * ux + uy * uy);
+        if (nrm > GS_R(0.0)) { f->up_x = ux / nrm; f->up_y = uy / nrm; }
         f->up_n++;
     }
 }
@@ -885,7 +904,7 @@ double gs_flight_stand_at(const gs_flight *f, double t_s)
 {
     /* the ring gives times back to the microsecond: same frame within half a millisecond */
     if (!f || f->stand_n == 0 || !(fabs(f->stand_last_t - t_s) < 5e-4)) return NAN;
-    return (double)f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
+    return (gs_real)f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
 }
 
 void gs_flight_forget_body(gs_flight *f)
@@ -898,13 +917,13 @@ void gs_flight_forget_body(gs_flight *f)
     if (!f->up_from_flight) f->up_n = 0;
 }
 
-static double size_ref(const gs_flight *f, const gs_sample_full *s)
+static gs_real size_ref(const gs_flight *f, const gs_sample_full *s)
 {
     if (f->stand_n > 0) {
         uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
         return f->stand_size[i];
     }
-    return (isfinite(s->size_px) && s->size_px > 0.0f) ? (double)s->size_px : NAN;
+    return (isfinite(s->size_px) && s->size_px > 0.0f) ? (gs_real)s->size_px : NAN;
 }
 
 static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
@@ -922,32 +941,32 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     f->n_hist++;
     if (f->n_hist < 3) return;
 
-    double um = med3(f->u_hist[0], f->u_hist[1], f->u_hist[2]);
+    gs_real um = med3(f->u_hist[0], f->u_hist[1], f->u_hist[2]);
     uint64_t im = f->i_hist[1];
     double tm = f->t_hist[1];
-    double d2 = f->u_hist[2] - 2.0 * f->u_hist[1] + f->u_hist[0];
-    double sz = size_ref(f, s);
+    gs_real d2 = f->u_hist[2] - GS_R(2.0) * f->u_hist[1] + f->u_hist[0];
+    gs_real sz = size_ref(f, s);
 
     /* keypoint noise, not motion: judged while nearly still (contact phases of a
      * jump series would otherwise pass for noise) */
-    double speed = speed_px_s(f, idx, s, f->u_hist[2]);
-    double sz_now = size_ref(f, s);
+    gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
+    gs_real sz_now = size_ref(f, s);
     bool still = isfinite(speed) && (!isfinite(sz_now) || speed < STAND_SPEED_REL * sz_now);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
-        f->noise_init[f->noise_n++] = (float)fabs(d2);
+        f->noise_init[f->noise_n++] = (float)GS_FABSR(d2);
         if (f->noise_n == NOISE_INIT_N) {
             float tmp[NOISE_INIT_N];
             for (uint32_t i = 0; i < NOISE_INIT_N; i++) tmp[i] = f->noise_init[i];
-            double med = median_f(tmp, NOISE_INIT_N);
-            f->noise_px = med / 1.652;  /* median |N(0, 6 s^2)| = 1.652 s */
-            if (f->noise_px < 0.05) f->noise_px = 0.05;
+            gs_real med = median_f(tmp, NOISE_INIT_N);
+            f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = 1.652 s */
+            if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
         }
     } else if (still) {
-        double a = fabs(d2) / 1.954;  /* E|N(0, 6 s^2)| = 1.954 s */
-        if (a > 3.0 * f->noise_px) a = 3.0 * f->noise_px;
-        f->noise_px += 0.02 * (a - f->noise_px);
+        gs_real a = GS_FABSR(d2) / GS_R(1.954);  /* E|N(0, 6 s^2)| = 1.954 s */
+        if (a > GS_R(3.0) * f->noise_px) a = GS_R(3.0) * f->noise_px;
+        f->noise_px += GS_R(0.02) * (a - f->noise_px);
     }
     update_standing(f, s, speed);
 
@@ -959,10 +978,10 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         f->blk_t0 = tm;
     }
     if (um < f->blk_min_cur) f->blk_min_cur = um;
-    double umin = f->blk_min_cur < f->blk_min_prev ? f->blk_min_cur : f->blk_min_prev;
+    gs_real umin = f->blk_min_cur < f->blk_min_prev ? f->blk_min_cur : f->blk_min_prev;
 
-    double nz = noise_floor(f);
-    double thr = SEED_RISE_NOISE * nz;
+    gs_real nz = noise_floor(f);
+    gs_real thr = SEED_RISE_NOISE * nz;
     if (isfinite(sz) && SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;
     DBG("g t=%.3f um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", tm, um, umin, thr, nz, sz, f->peak_u);
     /* a peak counts once it rose thr above the recent minimum; the drop that
@@ -972,8 +991,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         return;
     }
     if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; return; }
-    double drop = SEED_DROP_NOISE * nz;
-    if (isfinite(sz) && 0.01 * sz > drop) drop = 0.01 * sz;
+    gs_real drop = SEED_DROP_NOISE * nz;
+    if (isfinite(sz) && GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
     if (f->peak_u - um <= drop) return;
     uint64_t apex = f->peak_idx;
     double apex_t = f->peak_t;
@@ -1014,7 +1033,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     }
     uint64_t k = idx - f->fl_last - 1;  /* position among the pending samples */
     if (k >= 32) { land(f, idx, UINT64_MAX, s); return; }
-    double z;
+    gs_real z;
     bool ok = test_sample(f, &f->fit, &r, s, &z);
     DBG("t=%.4f ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", s->t_s, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
@@ -1026,14 +1045,14 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     /* deviations that persist for the configured latency end the flight, alarm or not */
     gs_sample_full edge_b;
     const gs_sample_full *edge = at(f, f->fl_last, &edge_b);
-    if (f->cusum > 0.0 && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
+    if (f->cusum > GS_R(0.0) && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
         land(f, idx, idx, s);
         return;
     }
     if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
         if (alarm_is_false(f, f->fl_first, idx, idx, +1)) {
             f->fl_last = idx;   /* the refit took every sample through idx */
-            f->cusum = 0.0;
+            f->cusum = GS_R(0.0);
             f->pend_ok = 0;
             return;
         }
@@ -1041,7 +1060,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         return;
     }
     f->pend_ok |= 1u << k;
-    if (f->cusum == 0.0) {
+    if (f->cusum == GS_R(0.0)) {
         /* everything pending was flight after all: take it in */
         for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
             gs_sample_full p_b;
@@ -1070,7 +1089,7 @@ void gs_flight_update(gs_flight *f)
         if (!present) continue;
         if (isfinite(f->last_t_s)) {
             double dt = s->t_s - f->last_t_s;
-            if (dt > 0.0) {
+            if (dt > GS_R(0.0)) {
                 if (!isfinite(f->dt_med_s)) f->dt_med_s = dt;
                 else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
             }

@@ -137,20 +137,35 @@ static void big_shr1(gs_big *b)
     while (b->n && b->w[b->n - 1u] == 0) b->n--;
 }
 
-/* b /= d, returns the remainder */
+/* b /= d for 0 < d <= 2^16, returns the remainder. Long division in 16-bit
+ * digits: every step is a 32-bit division (one instruction on a Cortex-M4, no
+ * 64-bit division helper linked). */
 static uint32_t big_divmod_small(gs_big *b, uint32_t d)
 {
-    uint64_t rem = 0;
+    uint32_t rem = 0;
     for (uint32_t i = b->n; i-- > 0;) {
-        uint64_t cur = (rem << 32) | b->w[i];
-        b->w[i] = (uint32_t)(cur / d);
-        rem = cur % d;
+        uint32_t w = b->w[i];
+        uint32_t hi = (rem << 16) | (w >> 16);   /* rem < d <= 2^16: no overflow */
+        uint32_t qh = hi / d;
+        rem = hi % d;
+        uint32_t lo = (rem << 16) | (w & 0xFFFFu);
+        b->w[i] = (qh << 16) | (lo / d);
+        rem = lo % d;
     }
     while (b->n && b->w[b->n - 1u] == 0) b->n--;
-    return (uint32_t)rem;
+    return rem;
 }
 
 /* ------------------------------------------------------------------ parse */
+
+/* 2^k for -1022 <= k <= 1023, from its bits */
+static double pow2(int k)
+{
+    uint64_t bits = (uint64_t)(k + 1023) << 52;
+    double d;
+    memcpy(&d, &bits, sizeof d);
+    return d;
+}
 
 /* value = (q + f) * 2^-s with 0 <= f < 1, f > 0 iff sticky; round half even
  * to the nearest double (subnormals included). false on overflow. */
@@ -179,7 +194,13 @@ static bool round_to_double(uint64_t q, bool sticky, int64_t s, bool neg, double
     } else {
         drop = 0; /* q holds >= 54 bits whenever sticky is set, so this is exact */
     }
-    double r = ldexp((double)qr, (int)(drop - s));
+    /* qr * 2^k is representable (qr was rounded to the bits it keeps): scaling by
+     * exact powers of two in steps that stay normal is exact (no ldexp linked) */
+    double r = (double)qr;
+    int64_t k = drop - s;
+    while (k > 1000) { r *= pow2(1000); k -= 1000; }
+    while (k < -1000) { r *= pow2(-1000); k += 1000; }
+    r *= pow2((int)k);
     if (isinf(r)) return false;
     *out = neg ? -r : r;
     return true;
@@ -277,7 +298,33 @@ static bool parse_slow(const char *s, size_t mant_len, int64_t nsig, int64_t nfr
     return round_to_double(q, sticky, sh, neg, out);
 }
 
+/* m * 10^e10 by scaling in double (m <= 19 digits): a few roundings, within 16 ulp
+ * of the correctly rounded value (relative 4e-15; subnormals lose more). */
+static bool scale_pow10(uint64_t m, int64_t e10, bool neg, double *out)
+{
+    double r = (double)m;
+    for (; e10 > 22; e10 -= 22) r *= 1e22;
+    for (; e10 < -22 && r != 0.0; e10 += 22) r /= 1e22;
+    if (e10 >= -22) r = e10 < 0 ? r / k_pow10_dbl[-e10] : r * k_pow10_dbl[e10];
+    if (isinf(r)) return false;
+    *out = neg ? -r : r;
+    return true;
+}
+
+static bool parse_impl(const char *s, size_t len, double *out, bool exact);
+
 bool gs_num_parse(const char *s, size_t len, double *out)
+{
+    /* where gs_real is float (a Cortex-M4) the exact slow path is not linked */
+    return parse_impl(s, len, out, !GS_REAL_IS_FLOAT);
+}
+
+bool gs_num_parse_scaled(const char *s, size_t len, double *out)
+{
+    return parse_impl(s, len, out, false);
+}
+
+static bool parse_impl(const char *s, size_t len, double *out, bool exact)
 {
     if (!s || !out) return false;
     size_t i = 0;
@@ -375,6 +422,7 @@ bool gs_num_parse(const char *s, size_t len, double *out)
             return true;
         }
     }
+    if (!exact) return scale_pow10(m, e10, neg, out);
     return parse_slow(s + mant_start, mant_end - mant_start, nsig, nfrac, e, neg, out);
 }
 
@@ -404,9 +452,9 @@ bool gs_num_parse_int(const char *s, size_t len, long *out)
 
 /* ------------------------------------------------------------------ format */
 
-/* The exact decimal expansion of a > 0: a = N * 10^-p, N in base-1e9 chunks. */
+/* The exact decimal expansion of a > 0: a = N * 10^-p, N in base-1e4 chunks. */
 typedef struct {
-    uint32_t c[90]; /* c[0] least significant */
+    uint16_t c[204]; /* base-10^4 chunks, c[0] least significant (810 digits) */
     int nc;
     int nd;         /* decimal digits of N */
     int p;
@@ -414,10 +462,18 @@ typedef struct {
 
 static void dec_expand(double a, gs_dec *d)
 {
-    int e;
-    double fm = frexp(a, &e);
-    uint64_t mant = (uint64_t)ldexp(fm, 53);
-    int e2 = e - 53;
+    /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
+    uint64_t bits;
+    memcpy(&bits, &a, sizeof bits);
+    int be = (int)((bits >> 52) & 0x7FFu);
+    uint64_t mant = bits & ((1ull << 52) - 1u);
+    int e2;
+    if (be == 0) {
+        e2 = -1074;  /* subnormal */
+    } else {
+        mant |= 1ull << 52;
+        e2 = be - 1075;
+    }
     while (!(mant & 1u)) {
         mant >>= 1;
         e2++;
@@ -433,11 +489,11 @@ static void dec_expand(double a, gs_dec *d)
         d->p = -e2;
     }
     d->nc = 0;
-    while (n.n && d->nc < 90) d->c[d->nc++] = big_divmod_small(&n, 1000000000u);
+    while (n.n && d->nc < 204) d->c[d->nc++] = (uint16_t)big_divmod_small(&n, 10000u);
     uint32_t top = d->c[d->nc - 1];
     int td = 1;
-    while (td < 9 && top >= k_pow10_u32[td]) td++;
-    d->nd = 9 * (d->nc - 1) + td;
+    while (td < 4 && top >= k_pow10_u32[td]) td++;
+    d->nd = 4 * (d->nc - 1) + td;
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -445,7 +501,7 @@ static int dec_digit(const gs_dec *d, int i)
 {
     if (i < 0 || i >= d->nd) return 0;
     int j = d->nd - 1 - i;
-    return (int)((d->c[j / 9] / k_pow10_u32[j % 9]) % 10u);
+    return (int)((d->c[j / 4] / k_pow10_u32[j % 4]) % 10u);
 }
 
 /* Keep the first n digits (n <= 30) in out[] as values 0..9, rounded half away

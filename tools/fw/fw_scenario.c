@@ -44,7 +44,7 @@ static void on_event(void *ctx, const gs_event *ev)
 static float bounce_m(float t)
 {
     const float g = 9.81f, flight = 0.45f, v0 = 0.5f * g * flight;
-    float x = fmodf(t, flight + 0.15f);
+    float x = t - (flight + 0.15f) * (float)(int)(t / (flight + 0.15f));  /* t >= 0: fmodf without libm */
     if (x > flight) return 0.0f;  /* on the floor */
     return v0 * x - 0.5f * g * x * x;
 }
