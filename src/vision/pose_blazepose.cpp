@@ -11,6 +11,8 @@
 #include <string>
 #include <sys/stat.h>
 
+#include "pose_look.hpp"
+
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -34,6 +36,14 @@ constexpr int kHeatmapKernel = 7;    // MediaPipe's refinement window (heatmap c
 constexpr float kHeatmapMinConf = 0.5f;
 constexpr double kRoiScale = 1.25;   // margin the landmark network was trained with
 constexpr double kMinRoiPx = 16.0;   // a tracked ROI smaller than this is no person
+// Look distance (Bhattacharyya, pose_look.hpp) above which a part is not the
+// kept person's, per part: trunk, upper arms, forearms, thighs, shanks, feet.
+// Measured on the gym jump alone (the reference following the body), the most
+// any part of the one person reached: trunk 0.63 (the take-off blur, the shirt
+// riding up), upper arms 0.71, forearms 0.72, thighs 0.72, shanks 0.38, feet
+// 0.56; a grey passer-by over the shanks 0.52-0.91. Arms and thighs change too
+// much with the pose to judge them by colour here.
+const double kLookMax[kLookParts] = {0.75, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 0.48, 0.48, 0.65, 0.65};
 
 double now_ms()
 {
@@ -501,6 +511,7 @@ struct PoseTracker::Impl {
     PoseKeeper keeper;
     bool crowded = false;              // the last census saw another person near the tracked one
     double last_census_t = -1e300;     // time of the detector's last run
+    PoseLook look;                     // the kept person's colours per body part
     double drift_r = 0.1;              // tracked vs fresh landmarks further apart than this x r: the ROI slid
 
     bool process(const cv::Mat &bgr, double t_s, PoseOutput *out);
@@ -732,6 +743,7 @@ void clear_output(PoseOutput *out, double t_s)
     out->roi = PoseRoi();
     out->persons = -1;
     out->rejected = false;
+    out->covered = 0;
     out->det_ms = 0.0;
     out->lm_ms = 0.0;
 }
@@ -758,6 +770,7 @@ void PoseTracker::reset()
 {
     p_->tracking = false;
     p_->keeper.forget();
+    p_->look.forget();
     p_->crowded = false;
     p_->last_census_t = -1e300;
 }
@@ -830,6 +843,7 @@ bool PoseTracker::Impl::process_keep(const cv::Mat &bgr, double t_s, PoseOutput 
 {
     if (keeper.has() && (t_s - keeper.last_t() > cfg.forget_s || t_s < keeper.last_t())) {
         keeper.forget();  // unseen too long (or a new stream): whoever comes next is a new person
+        look.forget();
         crowded = false;
     }
     PoseRoi next;
@@ -845,6 +859,26 @@ bool PoseTracker::Impl::process_keep(const cv::Mat &bgr, double t_s, PoseOutput 
         return out->present && next.size_px >= kMinRoiPx && std::isfinite(next.cx_px);
     };
     auto accept = [&](bool restart) {
+        // the look: parts whose colours are not the person's are covered (or someone else's)
+        PoseLookHist h[kLookParts];
+        double d[kLookParts];
+        pose_look_sample(bgr, out->kp, look.config().min_c, h);
+        look.compare(h, d);
+        int covered = 0;
+        for (int p = 0; p < kLookParts; p++) {
+            if (!(d[p] > kLookMax[p])) continue;
+            covered |= 1 << p;
+            for (const int *k = pose_look_part_keypoints(p); *k >= 0; k++) out->kp[*k].c = 0.0f;
+        }
+        out->covered = covered;
+        if (covered & (1 << kLookTrunk)) {  // the trunk is not the person's: nobody to follow here
+            out->rejected = true;
+            out->present = false;
+            for (int k = 0; k < kPoseKeypoints; k++) out->kp[k].c = 0.0f;
+            tracking = false;
+            return false;
+        }
+        look.learn(h, d);
         keeper.accept(body);
         roi = cfg.roi_smoothing ? smooth_roi(next, t_s, restart) : next;
         tracking = true;

@@ -196,6 +196,7 @@ struct PoseOutput {
     float in_frame[kPoseKeypoints];   // sigmoid of the presence logit (inside the image)
     PoseRoi roi;               // the crop the landmarks came from
     int persons = -1;          // persons the detector found this frame; -1 when it did not run
+    int covered = 0;           // bits (1 << PoseLookPart) of parts not the kept person's colours: their keypoints c = 0
     bool rejected = false;     // landmarks were found but judged not the tracked person's (someone
                                // else, or a body that cannot be there): present = false
     double det_ms = 0.0;       // this frame's detector time (pre- and post-processing included)

@@ -1,0 +1,332 @@
+// test_pose_crossing.cpp - one person kept while another walks through.
+//  - PoseKeeper (pure logic): which of two bodies is the tracked one, a body
+//    that jumps beyond what a body can do between frames, another size, a body
+//    nearer to someone else, forgetting after an absence.
+//  - A real composite: the man on the left of opencv-doc's basketball1.png (a
+//    rough hand-drawn polygon mask, scaled to the jumper's size) pasted walking
+//    at 1.6 m/s (17.5 px/frame at the jumper's 2.66 mm/px) across the jumpvision
+//    gym clip, in front of the jumper from the descent to after the landing
+//    (frames ~27-45), written losslessly (FFV1 .avi, 30 fps: the clip's own
+//    times) into a temp dir. Asserted: the clean FFV1 copy gives the mp4's one
+//    flight (within 2 frames of the app's 789 ms); today's ROI-only tracking
+//    (keep_person = off) ends on the walker (the clip is a real hard case).
+//    The crossing's end result (the same single flight, the same q) is NOT met
+//    yet and is asserted only with GS_TEST_CROSSING=1 (docs/pose.md, "One person").
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+extern "C" {
+#include "unity.h"
+}
+
+#include "pose_blazepose.hpp"
+
+#ifndef GS_SHARED_DIR
+#error "GS_SHARED_DIR must be defined"
+#endif
+
+void setUp(void) {}
+void tearDown(void) {}
+
+namespace {
+
+const char *const kWalkerPhoto = "/usr/share/doc/opencv-doc/examples/data/basketball1.png";
+// the man on the left of basketball1.png, outlined by hand on a 10 px grid
+// (head, shoulders, the arms and hands holding the ball, trousers, shoes)
+const cv::Point kMan[] = {{72, 84},   {92, 82},   {103, 95},  {104, 125}, {98, 140},  {115, 148}, {130, 160},
+                          {150, 150}, {162, 160}, {158, 185}, {140, 215}, {138, 260}, {134, 295}, {130, 360},
+                          {132, 430}, {138, 455}, {155, 462}, {152, 475}, {120, 475}, {112, 440}, {98, 360},
+                          {94, 320},  {86, 360},  {82, 430},  {82, 470},  {75, 480},  {45, 480},  {45, 440},
+                          {42, 360},  {46, 300},  {38, 270},  {36, 220},  {38, 170},  {50, 150},  {65, 142},
+                          {60, 125},  {58, 100}};
+
+struct Walk {
+    double scale = 1.55;      // 398 px of the photo -> 617 px, the jumper stands 639 px
+    double feet_y_px = 1100;  // a little nearer the camera than the jumper (feet ~1000)
+    double x0_px = -100;      // centre at the entry frame
+    double v_px = 17.5;       // per frame: 525 px/s = 1.4 m/s at 2.66 mm/px
+    int enter = 3;            // first frame with the walker
+};
+
+std::string g_dir, g_clean, g_cross;
+char g_gym[512];
+
+bool exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+// The gym clip re-written as FFV1 at 30 fps (the mp4's times are i/30 s), with
+// the walker pasted when w is given.
+bool write_clip(const std::string &out, const Walk *w)
+{
+    cv::VideoCapture cap(g_gym);
+    if (!cap.isOpened()) return false;
+    cv::Mat man, alpha;
+    if (w) {
+        cv::Mat photo = cv::imread(kWalkerPhoto, cv::IMREAD_COLOR);
+        if (photo.empty()) return false;
+        cv::Mat m(photo.size(), CV_8U, cv::Scalar(0));
+        std::vector<cv::Point> poly(kMan, kMan + sizeof kMan / sizeof kMan[0]);
+        cv::fillPoly(m, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(255));
+        cv::Rect bb = cv::boundingRect(poly) & cv::Rect(0, 0, photo.cols, photo.rows);
+        cv::resize(photo(bb), man, cv::Size(), w->scale, w->scale, cv::INTER_AREA);
+        cv::resize(m(bb), alpha, man.size(), 0, 0, cv::INTER_AREA);
+        cv::GaussianBlur(alpha, alpha, cv::Size(5, 5), 0);  // a soft edge, as a real cut-out
+    }
+    cv::VideoWriter vw;
+    cv::Mat f;
+    for (int i = 0; cap.read(f); i++) {
+        if (!vw.isOpened() &&
+            !vw.open(out, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, f.size()))
+            return false;
+        if (w && i >= w->enter) {
+            int cx = static_cast<int>(std::lround(w->x0_px + w->v_px * (i - w->enter)));
+            int ox = cx - man.cols / 2, oy = static_cast<int>(std::lround(w->feet_y_px)) - man.rows;
+            for (int y = 0; y < man.rows; y++) {
+                int Y = oy + y;
+                if (Y < 0 || Y >= f.rows) continue;
+                for (int x = 0; x < man.cols; x++) {
+                    int X = ox + x;
+                    if (X < 0 || X >= f.cols) continue;
+                    float a = alpha.at<uchar>(y, x) / 255.0f;
+                    if (a <= 0.0f) continue;
+                    cv::Vec3b &d = f.at<cv::Vec3b>(Y, X);
+                    const cv::Vec3b &p = man.at<cv::Vec3b>(y, x);
+                    for (int k = 0; k < 3; k++) d[k] = cv::saturate_cast<uchar>(a * p[k] + (1.0f - a) * d[k]);
+                }
+            }
+        }
+        vw.write(f);
+    }
+    return vw.isOpened();
+}
+
+struct Run {
+    int code = -1;
+    std::string out;
+};
+
+Run run(const std::string &args)
+{
+    std::string cmd = std::string(GS_PROGRAM) + " video " + args + " 2>/dev/null";
+    Run r;
+    FILE *p = popen(cmd.c_str(), "r");
+    TEST_ASSERT_NOT_NULL(p);
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+    int st = pclose(p);
+    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+    return r;
+}
+
+std::vector<std::string> lines_of(const std::string &out, const std::string &event)
+{
+    std::vector<std::string> v;
+    std::string pat = "\"event\":\"" + event + "\"";
+    size_t p = 0;
+    while (p < out.size()) {
+        size_t nl = out.find('\n', p);
+        if (nl == std::string::npos) nl = out.size();
+        std::string line = out.substr(p, nl - p);
+        if (line.find(pat) != std::string::npos) v.push_back(line);
+        p = nl + 1;
+    }
+    return v;
+}
+
+double num(const std::string &line, const char *key)
+{
+    std::string pat = std::string("\"") + key + "\":";
+    size_t k = line.find(pat);
+    if (k == std::string::npos) return NAN;
+    const char *s = line.c_str() + k + pat.size();
+    char *end;
+    double v = std::strtod(s, &end);
+    return end == s ? NAN : v;
+}
+
+// the tracked hip centre per frame (NaN when no pose)
+std::vector<cv::Point2d> hips(const std::string &clip, bool keep)
+{
+    gs::PoseConfig cfg;
+    cfg.keep_person = keep;
+    gs::PoseTracker t(cfg);
+    std::vector<cv::Point2d> v;
+    if (!t.ok()) return v;
+    cv::VideoCapture cap(clip);
+    cv::Mat f;
+    gs::PoseOutput o;
+    for (int i = 0; cap.read(f); i++) {
+        t.process(f, i / 30.0, &o);
+        if (o.present)
+            v.push_back(cv::Point2d(0.5 * (o.kp[23].x_px + o.kp[24].x_px), 0.5 * (o.kp[23].y_px + o.kp[24].y_px)));
+        else
+            v.push_back(cv::Point2d(NAN, NAN));
+    }
+    return v;
+}
+
+gs::PoseBody body(double t, double x, double y, double r)
+{
+    gs::PoseBody b;
+    b.t_s = t;
+    b.x_px = x;
+    b.y_px = y;
+    b.r_px = r;
+    return b;
+}
+
+}  // namespace
+
+// ---- the keeper's rules --------------------------------------------------------------
+
+static void test_keeper_keeps_the_tracked_body(void)
+{
+    gs::PoseKeeper k;
+    TEST_ASSERT_FALSE(k.has());
+    // a jumper rising at 1200 px/s (r 400 px, 30 fps: 40 px a frame)
+    for (int i = 0; i < 5; i++) k.accept(body(i / 30.0, 350.0, 700.0 - 40.0 * i, 400.0));
+    gs::PoseBody p = k.predict(5 / 30.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 500.0, p.y_px);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 350.0, p.x_px);
+    // the jumper where predicted (a little off) and a passer-by 120 px to the side at the same size
+    std::vector<gs::PoseBody> c = {body(5 / 30.0, 470.0, 520.0, 390.0), body(5 / 30.0, 360.0, 510.0, 410.0)};
+    TEST_ASSERT_EQUAL_INT(1, k.match(c));
+    // landmarks that are the jumper's, with the passer-by near: kept
+    std::vector<gs::PoseBody> other = {c[0]};
+    TEST_ASSERT_TRUE(k.keeps(body(5 / 30.0, 355.0, 505.0, 400.0), other));
+    // landmarks nearer to the passer-by than to where the jumper is: not kept
+    TEST_ASSERT_FALSE(k.keeps(body(5 / 30.0, 430.0, 515.0, 400.0), other));
+    // a body 200 px (0.5 r) off in one frame: beyond a body's acceleration
+    TEST_ASSERT_FALSE(k.plausible(body(5 / 30.0, 350.0, 300.0, 400.0)));
+    // another size (1.6x)
+    TEST_ASSERT_FALSE(k.plausible(body(5 / 30.0, 350.0, 500.0, 640.0)));
+    TEST_ASSERT_TRUE(k.plausible(body(5 / 30.0, 350.0, 500.0, 440.0)));
+    // nobody plausible: no match
+    std::vector<gs::PoseBody> far = {body(5 / 30.0, 50.0, 500.0, 400.0)};
+    TEST_ASSERT_EQUAL_INT(-1, k.match(far));
+    TEST_ASSERT_TRUE(k.near(far[0], 5 / 30.0));  // 300 px away: its body reaches the ROI
+    TEST_ASSERT_FALSE(k.near(body(5 / 30.0, 3000.0, 500.0, 400.0), 5 / 30.0));
+    // after a long absence the gate has opened (any position), the size still counts
+    TEST_ASSERT_TRUE(k.plausible(body(1.5, 50.0, 500.0, 400.0)));
+    k.forget();
+    TEST_ASSERT_FALSE(k.has());
+}
+
+static void test_keeper_config_keys(void)
+{
+    gs::PoseConfig c;
+    char msg[96];
+    TEST_ASSERT_TRUE(c.keep_person);
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs::pose_config_set(&c, "keep_person", 11, "off", 3, msg, sizeof msg));
+    TEST_ASSERT_FALSE(c.keep_person);
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs::pose_config_set(&c, "keep_person", 11, "1", 1, msg, sizeof msg));
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs::pose_config_set(&c, "recheck_s", 9, "0.5", 3, msg, sizeof msg));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.5, c.recheck_s);
+    TEST_ASSERT_EQUAL_INT(GS_ERANGE, gs::pose_config_set(&c, "recheck_s", 9, "-1", 2, msg, sizeof msg));
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs::pose_config_set(&c, "forget_s", 8, "2", 1, msg, sizeof msg));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 2.0, c.forget_s);
+}
+
+// ---- the composite -------------------------------------------------------------------
+
+static void test_clean_copy_keeps_the_flight(void)
+{
+    if (g_clean.empty()) TEST_IGNORE_MESSAGE("jumpvision_jumps or opencv-doc is absent");
+    Run r = run("'" + g_clean + "' --detector pose");
+    TEST_ASSERT_EQUAL_INT(0, r.code);
+    auto jumps = lines_of(r.out, "jump");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, (int)jumps.size(), r.out.c_str());
+    double ft = num(jumps[0], "flight_time_s");
+    std::printf("clean FFV1 copy: flight %.4f s, q %.6g m/px, height %.4f m\n", ft, num(jumps[0], "q_m_per_px"),
+                num(jumps[0], "height_m"));
+    TEST_ASSERT_DOUBLE_WITHIN(2.0 / 30.0, 0.789, ft);
+    TEST_ASSERT_EQUAL_INT(2, (int)lines_of(r.out, "session").size());
+}
+
+static void test_roi_tracking_alone_follows_the_walker(void)
+{
+    // The weakness the crossing shows: with the ROI alone, the landmark network's
+    // crop slides from the jumper's legs onto the walker while he passes in front
+    // (frames 27-37) and follows him out of the frame. Measured: at frame 45 the
+    // tracked hip is at x 618 (the walker's centre 605), the jumper's at 361.
+    if (g_cross.empty()) TEST_IGNORE_MESSAGE("jumpvision_jumps or opencv-doc is absent");
+    std::vector<cv::Point2d> clean = hips(g_clean, false), plain = hips(g_cross, false);
+    TEST_ASSERT_EQUAL_INT(54, (int)clean.size());
+    TEST_ASSERT_EQUAL_INT(54, (int)plain.size());
+    Walk w;
+    double walker_x = w.x0_px + w.v_px * (45 - w.enter);
+    std::printf("frame 45: ROI-only hip x %.0f, clean %.0f, walker %.0f\n", plain[45].x, clean[45].x, walker_x);
+    TEST_ASSERT_TRUE(std::fabs(plain[45].x - walker_x) < std::fabs(plain[45].x - clean[45].x));
+}
+
+static void test_crossing_keeps_the_jump(void)
+{
+    // The goal (issue 4): the same single flight and q as the clean copy with the
+    // walker crossing. Not met yet (docs/pose.md): run with GS_TEST_CROSSING=1.
+    if (g_cross.empty()) TEST_IGNORE_MESSAGE("jumpvision_jumps or opencv-doc is absent");
+    Run c = run("'" + g_clean + "' --detector pose");
+    Run r = run("'" + g_cross + "' --detector pose");
+    TEST_ASSERT_EQUAL_INT(0, r.code);
+    auto jc = lines_of(c.out, "jump"), jr = lines_of(r.out, "jump");
+    std::printf("crossing: %d flights, %d sessions\n", (int)jr.size(), (int)lines_of(r.out, "session").size());
+    for (const std::string &j : jr)
+        std::printf("  flight %.4f s, q %.6g m/px, height %.4f m, accepted %d\n", num(j, "flight_time_s"),
+                    num(j, "q_m_per_px"), num(j, "height_m"), j.find("\"accepted\":true") != std::string::npos);
+    if (!std::getenv("GS_TEST_CROSSING")) TEST_IGNORE_MESSAGE("pending: GS_TEST_CROSSING=1 asserts the goal");
+    TEST_ASSERT_EQUAL_INT(1, (int)jc.size());
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, (int)jr.size(), r.out.c_str());
+    TEST_ASSERT_DOUBLE_WITHIN(2.0 / 30.0, 0.789, num(jr[0], "flight_time_s"));
+    TEST_ASSERT_TRUE(jr[0].find("\"accepted\":true") != std::string::npos);
+    // q within 3 % of the clean run's (its own standard error is ~0.7 %; a few
+    // occluded frames dropped from a 27-sample fit)
+    TEST_ASSERT_DOUBLE_WITHIN(0.03 * num(jc[0], "q_m_per_px"), num(jc[0], "q_m_per_px"), num(jr[0], "q_m_per_px"));
+    TEST_ASSERT_EQUAL_INT(2, (int)lines_of(r.out, "session").size());
+    TEST_ASSERT_TRUE(jr[0].find("\"camera_moved\"") != std::string::npos);
+}
+
+int main(void)
+{
+    std::snprintf(g_gym, sizeof g_gym, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    char tmpl[] = "/tmp/gs_test_pose_crossing.XXXXXX";
+    bool data = exists(g_gym) && exists(kWalkerPhoto);
+    if (data && mkdtemp(tmpl)) {
+        g_dir = tmpl;
+        Walk w;
+        std::string clean = g_dir + "/clean.avi", cross = g_dir + "/crossing.avi";
+        if (write_clip(clean, nullptr) && write_clip(cross, &w)) {
+            g_clean = clean;
+            g_cross = cross;
+        } else {
+            std::fprintf(stderr, "cannot write the FFV1 clips in %s\n", g_dir.c_str());
+            return 1;
+        }
+    }
+    UNITY_BEGIN();
+    RUN_TEST(test_keeper_keeps_the_tracked_body);
+    RUN_TEST(test_keeper_config_keys);
+    RUN_TEST(test_clean_copy_keeps_the_flight);
+    RUN_TEST(test_roi_tracking_alone_follows_the_walker);
+    RUN_TEST(test_crossing_keeps_the_jump);
+    int rc = UNITY_END();
+    if (!g_dir.empty()) {
+        std::remove((g_dir + "/clean.avi").c_str());
+        std::remove((g_dir + "/crossing.avi").c_str());
+        rmdir(g_dir.c_str());
+    }
+    return rc;
+}
