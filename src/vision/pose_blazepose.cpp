@@ -905,11 +905,11 @@ bool PoseTracker::Impl::process_keep(const cv::Mat &bgr, double t_s, PoseOutput 
         crowded = false;
         if (tracking && lm_ok) {
             // the ROI's person stays the one (no identity yet to compare with)
-            accept(false);
+            bool kept = accept(false);
             int me = keeper.match(bodies);
             for (size_t i = 0; i < bodies.size(); i++)
                 if (static_cast<int>(i) != me) crowded = crowded || keeper.near(bodies[i], t_s);
-            return true;
+            return kept;
         }
         if (dets.empty()) {
             tracking = false;
@@ -922,11 +922,11 @@ bool PoseTracker::Impl::process_keep(const cv::Mat &bgr, double t_s, PoseOutput 
         PoseRoi r = pose_roi_from_alignment(dets.front().kp_x[0], dets.front().kp_y[0], dets.front().kp_x[1],
                                             dets.front().kp_y[1], kRoiScale);
         if (run_lm(r)) {
-            accept(true);
+            bool kept = accept(true);
             int me = keeper.match(bodies);
             for (size_t i = 0; i < bodies.size(); i++)
                 if (static_cast<int>(i) != me) crowded = crowded || keeper.near(bodies[i], t_s);
-            return true;
+            return kept;
         }
         tracking = false;
         return out->present;

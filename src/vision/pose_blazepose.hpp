@@ -9,6 +9,12 @@
 // alignment points for the next frame's ROI. The detector runs again only
 // when the pose presence score drops below min_tracking (tracking lost); the
 // lost frame is retried with the detector at once, so no frame is skipped.
+// One person is kept (keep_person, docs/pose.md "One person"): the detector
+// re-checks every recheck_s (every frame while someone else is near, or when
+// the landmarks jump beyond what a body can do); a re-detection takes the
+// person that matches the tracked one (PoseKeeper), not the most confident;
+// body parts whose colours are not the person's (PoseLook, pose_look.hpp) give
+// c = 0, and a trunk that is not the person's gives no pose that frame.
 // No landmark smoothing: the core fits the raw points (a filter would bend the
 // free-flight parabola). Optionally (roi_smoothing) the ROI's two alignment
 // points pass a one-euro filter as in MediaPipe, which steadies the crop of a
