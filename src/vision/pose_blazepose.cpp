@@ -11,6 +11,8 @@
 #include <string>
 #include <sys/stat.h>
 
+#include "pose_look.hpp"
+
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -34,6 +36,14 @@ constexpr int kHeatmapKernel = 7;    // MediaPipe's refinement window (heatmap c
 constexpr float kHeatmapMinConf = 0.5f;
 constexpr double kRoiScale = 1.25;   // margin the landmark network was trained with
 constexpr double kMinRoiPx = 16.0;   // a tracked ROI smaller than this is no person
+// Look distance (Bhattacharyya, pose_look.hpp) above which a part is not the
+// kept person's, per part: trunk, upper arms, forearms, thighs, shanks, feet.
+// Measured on the gym jump alone (the reference following the body), the most
+// any part of the one person reached: trunk 0.63 (the take-off blur, the shirt
+// riding up), upper arms 0.71, forearms 0.72, thighs 0.72, shanks 0.38, feet
+// 0.56; a grey passer-by over the shanks 0.52-0.91. Arms and thighs change too
+// much with the pose to judge them by colour here.
+const double kLookMax[kLookParts] = {0.75, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 0.48, 0.48, 0.65, 0.65};
 
 double now_ms()
 {
@@ -191,6 +201,17 @@ gs_status pose_config_set(void *ctx, const char *key, size_t key_len, const char
         }
         return GS_OK;
     }
+    if (key_is(key, key_len, "keep_person")) {
+        if (v == "on") c->keep_person = true;
+        else if (v == "off") c->keep_person = false;
+        else {
+            put_msg(msg, cap, "expected on or off");
+            return GS_EINVAL;
+        }
+        return GS_OK;
+    }
+    if (key_is(key, key_len, "recheck_s")) return num_in(value, value_len, 0.0, 60.0, &c->recheck_s, msg, cap);
+    if (key_is(key, key_len, "forget_s")) return num_in(value, value_len, 0.05, 600.0, &c->forget_s, msg, cap);
     if (key_is(key, key_len, "heatmap_refine")) {
         if (v == "on") c->heatmap_refine = true;
         else if (v == "off") c->heatmap_refine = false;
@@ -381,6 +402,90 @@ std::vector<PoseDetection> pose_decode_detections(const float *regressors, const
     return out;
 }
 
+// ------------------------------------------------------------------ keeper ---
+
+PoseBody PoseKeeper::predict(double t_s) const
+{
+    PoseBody p = hist_.back();
+    if (hist_.size() >= 2) {
+        const PoseBody &a = hist_[hist_.size() - 2], &b = hist_.back();
+        double dt = b.t_s - a.t_s;
+        if (dt > 0.0) {
+            double vx = (b.x_px - a.x_px) / dt, vy = (b.y_px - a.y_px) / dt;
+            double v = std::hypot(vx, vy), vmax = cfg_.max_speed_r_s * b.r_px;
+            if (v > vmax) {
+                vx *= vmax / v;
+                vy *= vmax / v;
+            }
+            double h = std::max(0.0, t_s - b.t_s);
+            p.x_px += vx * h;
+            p.y_px += vy * h;
+        }
+    }
+    p.t_s = t_s;
+    return p;
+}
+
+double PoseKeeper::cost(const PoseBody &b) const
+{
+    PoseBody p = predict(b.t_s);
+    return std::hypot(b.x_px - p.x_px, b.y_px - p.y_px) / p.r_px + std::fabs(std::log(b.r_px / p.r_px));
+}
+
+bool PoseKeeper::plausible(const PoseBody &b) const
+{
+    if (hist_.empty()) return true;
+    if (!(b.r_px > 0.0) || !std::isfinite(b.x_px) || !std::isfinite(b.y_px)) return false;
+    PoseBody p = predict(b.t_s);
+    double h = std::max(0.0, b.t_s - hist_.back().t_s);
+    double gate = (cfg_.gate_r + 0.5 * cfg_.max_accel_r_s2 * h * h) * p.r_px;
+    if (std::hypot(b.x_px - p.x_px, b.y_px - p.y_px) > gate) return false;
+    double k = b.r_px / p.r_px;
+    return k <= cfg_.size_ratio && k >= 1.0 / cfg_.size_ratio;
+}
+
+int PoseKeeper::match(const std::vector<PoseBody> &cands) const
+{
+    int best = -1;
+    double bc = 0.0;
+    for (size_t i = 0; i < cands.size(); i++) {
+        if (!plausible(cands[i])) continue;
+        double c = cost(cands[i]);
+        if (best < 0 || c < bc) {
+            best = static_cast<int>(i);
+            bc = c;
+        }
+    }
+    return best;
+}
+
+bool PoseKeeper::near(const PoseBody &o, double t_s) const
+{
+    if (hist_.empty()) return false;
+    PoseBody p = predict(t_s);
+    return std::hypot(o.x_px - p.x_px, o.y_px - p.y_px) < cfg_.near_r * (p.r_px + o.r_px);
+}
+
+bool PoseKeeper::keeps(const PoseBody &b, const std::vector<PoseBody> &others) const
+{
+    if (!plausible(b)) return false;
+    if (hist_.empty()) return true;
+    PoseBody p = predict(b.t_s);
+    double d = std::hypot(b.x_px - p.x_px, b.y_px - p.y_px);
+    for (const PoseBody &o : others)
+        if (std::hypot(b.x_px - o.x_px, b.y_px - o.y_px) <= d) return false;
+    return true;
+}
+
+void PoseKeeper::accept(const PoseBody &b)
+{
+    if (!hist_.empty() && b.t_s <= hist_.back().t_s) hist_.clear();  // time went back: a new stream
+    hist_.push_back(b);
+    size_t drop = 0;
+    while (drop + 2 < hist_.size() && b.t_s - hist_[drop].t_s > cfg_.history_s) drop++;
+    if (drop) hist_.erase(hist_.begin(), hist_.begin() + static_cast<std::ptrdiff_t>(drop));
+}
+
 // ----------------------------------------------------------------- tracker ---
 
 struct PoseTracker::Impl {
@@ -402,7 +507,16 @@ struct PoseTracker::Impl {
     double align[4] = {0, 0, 0, 0};  // the last landmarks' alignment points, image px
     cv::Mat converted;                // a grey or BGRA frame as BGR
 
+    // keeping one person
+    PoseKeeper keeper;
+    bool crowded = false;              // the last census saw another person near the tracked one
+    double last_census_t = -1e300;     // time of the detector's last run
+    PoseLook look;                     // the kept person's colours per body part
+    double drift_r = 0.1;              // tracked vs fresh landmarks further apart than this x r: the ROI slid
+
     bool process(const cv::Mat &bgr, double t_s, PoseOutput *out);
+    bool process_plain(const cv::Mat &bgr, double t_s, PoseOutput *out);
+    bool process_keep(const cv::Mat &bgr, double t_s, PoseOutput *out);
 
     // 8-bit BGR as is; 8-bit grey or BGRA converted; anything else: nullptr
     const cv::Mat *as_bgr(const cv::Mat &img)
@@ -627,6 +741,9 @@ void clear_output(PoseOutput *out, double t_s)
         out->in_frame[i] = kNaNf;
     }
     out->roi = PoseRoi();
+    out->persons = -1;
+    out->rejected = false;
+    out->covered = 0;
     out->det_ms = 0.0;
     out->lm_ms = 0.0;
 }
@@ -649,7 +766,14 @@ PoseTracker::~PoseTracker() = default;
 bool PoseTracker::ok() const { return p_->ok; }
 const std::string &PoseTracker::error() const { return p_->error; }
 
-void PoseTracker::reset() { p_->tracking = false; }
+void PoseTracker::reset()
+{
+    p_->tracking = false;
+    p_->keeper.forget();
+    p_->look.forget();
+    p_->crowded = false;
+    p_->last_census_t = -1e300;
+}
 
 std::vector<PoseDetection> PoseTracker::detect(const cv::Mat &bgr)
 {
@@ -692,6 +816,171 @@ bool PoseTracker::process(const cv::Mat &bgr, double t_s, PoseOutput *out)
 }
 
 bool PoseTracker::Impl::process(const cv::Mat &bgr, double t_s, PoseOutput *out)
+{
+    return cfg.keep_person ? process_keep(bgr, t_s, out) : process_plain(bgr, t_s, out);
+}
+
+namespace {
+PoseBody body_of(const PoseDetection &d, double t_s)
+{
+    PoseBody b;
+    b.t_s = t_s;
+    b.x_px = d.kp_x[0];
+    b.y_px = d.kp_y[0];
+    b.r_px = std::hypot(d.kp_x[1] - d.kp_x[0], d.kp_y[1] - d.kp_y[0]);
+    return b;
+}
+}  // namespace
+
+// One person kept (docs/pose.md, "One person"): the landmarks of the tracked ROI
+// are taken when no census is due and they lie where the tracked body can be;
+// otherwise the detector runs and says who is where: the tracked person is the
+// plausible detection nearest to the prediction, the others are someone else;
+// the ROI's landmarks are kept when they are nearer to the tracked person than
+// to anyone else, else the tracked person's own detection is tried, else the
+// frame gives no pose and the next frame asks the detector again.
+bool PoseTracker::Impl::process_keep(const cv::Mat &bgr, double t_s, PoseOutput *out)
+{
+    if (keeper.has() && (t_s - keeper.last_t() > cfg.forget_s || t_s < keeper.last_t())) {
+        keeper.forget();  // unseen too long (or a new stream): whoever comes next is a new person
+        look.forget();
+        crowded = false;
+    }
+    PoseRoi next;
+    PoseBody body;
+    auto run_lm = [&](const PoseRoi &r) {
+        double t0 = now_ms();
+        landmarks(bgr, r, out, &next);
+        out->lm_ms += now_ms() - t0;
+        body.t_s = t_s;
+        body.x_px = align[0];
+        body.y_px = align[1];
+        body.r_px = std::hypot(align[2] - align[0], align[3] - align[1]);
+        return out->present && next.size_px >= kMinRoiPx && std::isfinite(next.cx_px);
+    };
+    auto accept = [&](bool restart) {
+        // the look: parts whose colours are not the person's are covered (or someone else's)
+        PoseLookHist h[kLookParts];
+        double d[kLookParts];
+        pose_look_sample(bgr, out->kp, look.config().min_c, h);
+        look.compare(h, d);
+        int covered = 0;
+        for (int p = 0; p < kLookParts; p++) {
+            if (!(d[p] > kLookMax[p])) continue;
+            covered |= 1 << p;
+            for (const int *k = pose_look_part_keypoints(p); *k >= 0; k++) out->kp[*k].c = 0.0f;
+        }
+        out->covered = covered;
+        if (covered & (1 << kLookTrunk)) {  // the trunk is not the person's: nobody to follow here
+            out->rejected = true;
+            out->present = false;
+            for (int k = 0; k < kPoseKeypoints; k++) out->kp[k].c = 0.0f;
+            tracking = false;
+            return false;
+        }
+        look.learn(h, d);
+        keeper.accept(body);
+        roi = cfg.roi_smoothing ? smooth_roi(next, t_s, restart) : next;
+        tracking = true;
+        return true;
+    };
+    bool lm_ok = false;
+    if (tracking) {
+        lm_ok = run_lm(roi);
+        bool census_due = crowded || t_s - last_census_t >= cfg.recheck_s || t_s < last_census_t;
+        if (lm_ok && !census_due && (!keeper.has() || keeper.plausible(body))) return accept(false);
+    }
+    // the census: who is where
+    double t0 = now_ms();
+    std::vector<PoseDetection> dets = detect(bgr);
+    out->det_ms += now_ms() - t0;
+    out->detector_ran = true;
+    out->persons = static_cast<int>(dets.size());
+    last_census_t = t_s;
+    std::vector<PoseBody> bodies;
+    for (const PoseDetection &d : dets) bodies.push_back(body_of(d, t_s));
+
+    if (!keeper.has()) {
+        // nobody kept: the most confident person is the one to follow
+        crowded = false;
+        if (tracking && lm_ok) {
+            // the ROI's person stays the one (no identity yet to compare with)
+            bool kept = accept(false);
+            int me = keeper.match(bodies);
+            for (size_t i = 0; i < bodies.size(); i++)
+                if (static_cast<int>(i) != me) crowded = crowded || keeper.near(bodies[i], t_s);
+            return kept;
+        }
+        if (dets.empty()) {
+            tracking = false;
+            if (!out->present) return false;
+            out->present = false;  // landmarks without a usable next ROI and nobody found
+            for (int k = 0; k < kPoseKeypoints; k++) out->kp[k].c = 0.0f;
+            return false;
+        }
+        out->det_score = dets.front().score;
+        PoseRoi r = pose_roi_from_alignment(dets.front().kp_x[0], dets.front().kp_y[0], dets.front().kp_x[1],
+                                            dets.front().kp_y[1], kRoiScale);
+        if (run_lm(r)) {
+            bool kept = accept(true);
+            int me = keeper.match(bodies);
+            for (size_t i = 0; i < bodies.size(); i++)
+                if (static_cast<int>(i) != me) crowded = crowded || keeper.near(bodies[i], t_s);
+            return kept;
+        }
+        tracking = false;
+        return out->present;
+    }
+
+    int m = keeper.match(bodies);
+    std::vector<PoseBody> others;
+    crowded = false;
+    for (size_t i = 0; i < bodies.size(); i++) {
+        if (static_cast<int>(i) == m) continue;
+        others.push_back(bodies[i]);
+        crowded = crowded || keeper.near(bodies[i], t_s);
+    }
+    if (tracking && lm_ok && keeper.keeps(body, others)) {
+        if (m < 0) return accept(false);
+        // a second opinion: the landmarks of the tracked person's own detection. A
+        // tracked ROI that slid (onto someone the detector does not report) disagrees
+        PoseOutput mine = *out;
+        PoseRoi mine_next = next;
+        PoseBody mine_body = body;
+        const PoseDetection &d = dets[static_cast<size_t>(m)];
+        PoseRoi r = pose_roi_from_alignment(d.kp_x[0], d.kp_y[0], d.kp_x[1], d.kp_y[1], kRoiScale);
+        if (run_lm(r) && std::hypot(body.x_px - mine_body.x_px, body.y_px - mine_body.y_px) >
+                             drift_r * mine_body.r_px) {
+            out->det_score = d.score;
+            if (keeper.plausible(body)) return accept(true);  // the fresh crop is the person
+            out->rejected = true;
+            out->present = false;
+            for (int k = 0; k < kPoseKeypoints; k++) out->kp[k].c = 0.0f;
+            tracking = false;
+            return false;
+        }
+        double lm_ms = out->lm_ms;
+        *out = mine;
+        out->lm_ms = lm_ms;
+        next = mine_next;
+        body = mine_body;
+        return accept(false);
+    }
+    if (m >= 0) {
+        const PoseDetection &d = dets[static_cast<size_t>(m)];
+        out->det_score = d.score;
+        PoseRoi r = pose_roi_from_alignment(d.kp_x[0], d.kp_y[0], d.kp_x[1], d.kp_y[1], kRoiScale);
+        if (run_lm(r) && keeper.keeps(body, others)) return accept(true);
+    }
+    // not the tracked person, or not found: no pose this frame; the detector looks again next frame
+    out->rejected = out->present;
+    out->present = false;
+    for (int k = 0; k < kPoseKeypoints; k++) out->kp[k].c = 0.0f;
+    tracking = false;
+    return false;
+}
+
+bool PoseTracker::Impl::process_plain(const cv::Mat &bgr, double t_s, PoseOutput *out)
 {
     // landmarks of the current ROI; true when the pose is there and the next ROI usable
     auto track = [&]() {

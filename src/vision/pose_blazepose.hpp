@@ -9,6 +9,12 @@
 // alignment points for the next frame's ROI. The detector runs again only
 // when the pose presence score drops below min_tracking (tracking lost); the
 // lost frame is retried with the detector at once, so no frame is skipped.
+// One person is kept (keep_person, docs/pose.md "One person"): the detector
+// re-checks every recheck_s (every frame while someone else is near, or when
+// the landmarks jump beyond what a body can do); a re-detection takes the
+// person that matches the tracked one (PoseKeeper), not the most confident;
+// body parts whose colours are not the person's (PoseLook, pose_look.hpp) give
+// c = 0, and a trunk that is not the person's gives no pose that frame.
 // No landmark smoothing: the core fits the raw points (a filter would bend the
 // free-flight parabola). Optionally (roi_smoothing) the ROI's two alignment
 // points pass a one-euro filter as in MediaPipe, which steadies the crop of a
@@ -47,6 +53,16 @@ struct PoseConfig {
     bool heatmap_refine = true;    // refine x, y with the landmark heatmap (as MediaPipe)
     bool roi_smoothing = false;    // one-euro filter on the tracked ROI's alignment points (never on keypoints);
                                    // off: it steadies a still person's crop, but the flight residuals were mixed (docs/pose.md)
+    // Keeping one person (docs/pose.md, "One person"): while a person is tracked,
+    // the detector re-checks the scene every recheck_s; while another person is
+    // near, every frame. The landmarks are the tracked person's only when they
+    // lie where that body can be (its motion predicted from the last accepted
+    // frames) and nearer to it than to anyone else; otherwise the person's own
+    // detection is tried, else the frame gives no pose (c = 0). A person unseen
+    // for forget_s is forgotten: the next one found is a new person.
+    bool keep_person = true;       // off: the old behaviour (follow the ROI, most confident when lost)
+    double recheck_s = 0.25;       // detector census while tracking alone
+    double forget_s = 1.0;         // a tracked person unseen this long is forgotten
 };
 
 // gs_cfg_handler for [pose]; ctx is a PoseConfig*. Keys: models, model,
@@ -119,6 +135,57 @@ std::vector<PoseDetection> pose_decode_detections(const float *regressors, const
                                                   const PoseLetterbox &lb, double min_score,
                                                   double nms_iou);
 
+// ---- keeping one person (pure logic, tested without the networks) ----------------
+
+// A body as the ROI rule sees it: the hip centre and the distance to the scale
+// point (the detector's keypoints 0 and 1, the landmarks' alignment points 33
+// and 34), image px.
+struct PoseBody {
+    double t_s = 0.0;
+    double x_px = 0.0, y_px = 0.0;
+    double r_px = 0.0;
+};
+
+// The tracked person's recent accepted bodies and the rules that say whether
+// a body is that person: where it can be now (constant velocity from the last
+// two accepted frames, the speed capped at max_speed_r_s body radii a second),
+// how far from there (gate_r radii plus max_accel_r_s2 x dt^2 / 2) and how much
+// its size may differ (size_ratio).
+struct PoseKeeperConfig {
+    double gate_r = 0.35;          // position gate at the frame after an accepted one, in body radii
+    double max_speed_r_s = 8.0;    // a hip faster than this (radii/s) is no body (a jump's take-off: ~4)
+    double max_accel_r_s2 = 60.0;  // widening of the gate with time since the last accepted frame
+    double size_ratio = 1.4;       // r beyond this factor of the last accepted r is someone else
+    double near_r = 2.2;           // another person whose hip is nearer than near_r x (r + its r) is near
+    double history_s = 1.0;        // accepted bodies kept this long
+};
+
+class PoseKeeper {
+public:
+    explicit PoseKeeper(const PoseKeeperConfig &cfg = PoseKeeperConfig()) : cfg_(cfg) {}
+    bool has() const { return !hist_.empty(); }
+    double last_t() const { return hist_.empty() ? -1e300 : hist_.back().t_s; }
+    // where the tracked body is expected at t (has() must be true)
+    PoseBody predict(double t_s) const;
+    // b is where the tracked body can be at its time
+    bool plausible(const PoseBody &b) const;
+    // normalised distance of b from the prediction (position in radii + size log-ratio)
+    double cost(const PoseBody &b) const;
+    // the candidate that is the tracked person: the plausible one of lowest cost; -1 none
+    int match(const std::vector<PoseBody> &cands) const;
+    // someone (not the tracked person) whose body reaches the tracked one's ROI
+    bool near(const PoseBody &other, double t_s) const;
+    // b is the tracked body and not one of others: plausible, and nearer to the
+    // prediction than any other person is
+    bool keeps(const PoseBody &b, const std::vector<PoseBody> &others) const;
+    void accept(const PoseBody &b);
+    void forget() { hist_.clear(); }
+
+private:
+    PoseKeeperConfig cfg_;
+    std::vector<PoseBody> hist_;
+};
+
 // ---- the tracker ---------------------------------------------------------------
 
 constexpr int kPoseKeypoints = 33;
@@ -134,6 +201,10 @@ struct PoseOutput {
     float visibility[kPoseKeypoints]; // sigmoid of the visibility logit (not occluded)
     float in_frame[kPoseKeypoints];   // sigmoid of the presence logit (inside the image)
     PoseRoi roi;               // the crop the landmarks came from
+    int persons = -1;          // persons the detector found this frame; -1 when it did not run
+    int covered = 0;           // bits (1 << PoseLookPart) of parts not the kept person's colours: their keypoints c = 0
+    bool rejected = false;     // landmarks were found but judged not the tracked person's (someone
+                               // else, or a body that cannot be there): present = false
     double det_ms = 0.0;       // this frame's detector time (pre- and post-processing included)
     double lm_ms = 0.0;        // this frame's landmark time
 };
