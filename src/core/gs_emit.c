@@ -460,9 +460,14 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
 
 size_t gs_emit(gs_format fmt, const gs_event *ev, char *buf, size_t cap)
 {
+    /* a format left out of the build (gs_features.h) writes nothing */
     switch (fmt) {
-    case GS_FMT_JSON: return gs_emit_json(ev, buf, cap);
-    case GS_FMT_NMEA: return gs_emit_nmea(ev, buf, cap);
+    case GS_FMT_JSON:
+        if (GS_WITH_JSON) return gs_emit_json(ev, buf, cap);
+        break;
+    case GS_FMT_NMEA:
+        if (GS_WITH_NMEA) return gs_emit_nmea(ev, buf, cap);
+        break;
     }
     if (buf && cap) buf[0] = '\0';
     return 0;
