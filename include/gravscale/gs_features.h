@@ -23,7 +23,16 @@
 #ifndef GS_WITH_BLAZEPOSE33
 #define GS_WITH_BLAZEPOSE33 1
 #endif
-/* a skeleton layout: the COM model, standing posture, visits (sessions) */
+/* the fit method "ransac" (fit = ransac; irls and plain are always in) */
+#ifndef GS_WITH_RANSAC
+#define GS_WITH_RANSAC 1
+#endif
+/* trace events (gs_pipeline_set_trace: state, sample and fit events, for
+ * debugging); off, the core emits none and gs_pipeline_set_trace has no effect */
+#ifndef GS_WITH_TRACE
+#define GS_WITH_TRACE 1
+#endif
+/* a skeleton layout: the COM model, the standing tracker, visits (sessions) */
 #define GS_WITH_POSE (GS_WITH_COCO17 || GS_WITH_BLAZEPOSE33)
 
 #if !GS_WITH_JSON && !GS_WITH_NMEA

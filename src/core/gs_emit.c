@@ -288,6 +288,7 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
         w_warnings(&w, ev->u.warning.warnings);
         w_lit(&w, "}\n");
         break;
+#if GS_WITH_TRACE /* trace events (gs_features.h): without them, no form (returns 0) */
     case GS_EV_STATE: {
         const gs_ev_state *s = &ev->u.state;
         w_lit(&w, "{\"event\":\"state\",\"t_s\":");
@@ -335,6 +336,7 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
         w_lit(&w, "}\n");
         break;
     }
+#endif
     default: w.ok = false; break;
     }
     return w_finish(&w);

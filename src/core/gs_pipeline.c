@@ -120,7 +120,7 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
     if (st != GS_OK) return st;
     p->last_t_s = s->t_s;
     p->n_frames++;
-    if (p->flight.trace && p->on_event) {
+    if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
         ev.type = GS_EV_SAMPLE;
