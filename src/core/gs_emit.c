@@ -28,7 +28,12 @@ static void w_raw(gs_w *w, const char *s, size_t n)
     w->len += n;
 }
 
-static void w_lit(gs_w *w, const char *s) { w_raw(w, s, strlen(s)); }
+static void w_lit(gs_w *w, const char *s)
+{
+    size_t n = 0; /* not strlen: a device build need not link libc's (220 B) */
+    while (s[n]) n++;
+    w_raw(w, s, n);
+}
 
 static void w_u32(gs_w *w, uint32_t v)
 {
@@ -372,7 +377,10 @@ static void n_text(gs_w *w, const char *s, size_t max_len)
     w_raw(w, ",", 1);
     for (size_t i = 0; s && s[i] && i < max_len; i++) {
         char c = s[i];
-        if (c < 0x20 || c > 0x7e || strchr("$*,!\\^~", c)) c = '_';
+        /* NMEA's reserved characters (not strchr: no libc search linked for this) */
+        if (c < 0x20 || c > 0x7e || c == '$' || c == '*' || c == ',' || c == '!' || c == '\\' || c == '^' ||
+            c == '~')
+            c = '_';
         w_raw(w, &c, 1);
     }
 }

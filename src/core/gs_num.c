@@ -543,20 +543,20 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     if (!isfinite(v) || fabs(v) >= 1e15 || decimals < 0 || decimals > 9)
         return put_fail(buf, cap);
-    char dig[32]; /* the integer round(|v| * 10^decimals), most significant first */
+    char buf_dig[32]; /* the integer round(|v| * 10^decimals), most significant first */
+    char *dig = buf_dig + 1;
     int nd = 0;
     if (v != 0.0) {
         gs_dec d;
         dec_expand(fabs(v), &d);
         int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
         if (count >= 0) {
-            int carry = dec_round(&d, count, dig + 1);
-            if (carry) {
+            int carry = dec_round(&d, count, dig);
+            nd = count;
+            if (carry) { /* a new leading 1 in front (no memmove linked) */
+                dig = buf_dig;
                 dig[0] = 1;
                 nd = count + 1;
-            } else {
-                memmove(dig, dig + 1, (size_t)count);
-                nd = count;
             }
         }
     }
