@@ -28,11 +28,14 @@ static void w_raw(gs_w *w, const char *s, size_t n)
     w->len += n;
 }
 
+/* byte by byte, as w_raw would (one byte kept for the NUL): a counting loop
+ * would become a strlen call, which a device build need not link (220 B) */
 static void w_lit(gs_w *w, const char *s)
 {
-    size_t n = 0; /* not strlen: a device build need not link libc's (220 B) */
-    while (s[n]) n++;
-    w_raw(w, s, n);
+    for (; *s && w->ok; s++) {
+        if (w->len + 2u > w->cap) w->ok = false;
+        else w->buf[w->len++] = *s;
+    }
 }
 
 static void w_u32(gs_w *w, uint32_t v)
