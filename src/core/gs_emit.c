@@ -381,6 +381,21 @@ static void n_num(gs_w *w, double v, int decimals, size_t width)
     }
 }
 
+/* fields of a sentence from a table, as json_field: offset, decimals and width of a double */
+typedef struct {
+    uint8_t off, decimals, width;
+} nmea_field;
+#define NF(type, field, dec, width) {(uint8_t)offsetof(type, field), dec, width}
+
+static void n_fields(gs_w *w, const void *base, const nmea_field *t, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double v;
+        memcpy(&v, (const char *)base + t[i].off, sizeof v);
+        n_num(w, v, t[i].decimals, t[i].width);
+    }
+}
+
 static void n_u32(gs_w *w, uint32_t v)
 {
     w_raw(w, ",", 1);
@@ -408,15 +423,14 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
     switch (ev->type) {
     case GS_EV_JUMP: {
         /* widths: 10+5+8+9+6+5+6+10+1+1 = 61 = 82 - "$GSJMP" - 10 commas - "*HH\r\n" */
+        static const nmea_field k_jmp[] = {
+            NF(gs_ev_jump, t_takeoff_s, 3, 10), NF(gs_ev_jump, flight_time_s, 3, 5),
+            NF(gs_ev_jump, a_px_s2, 1, 8),      NF(gs_ev_jump, q_m_per_px, 7, 9),
+            NF(gs_ev_jump, height_m, 3, 6),     NF(gs_ev_jump, jump_height_m, 3, 5),
+            NF(gs_ev_jump, takeoff_velocity_m_s, 2, 6)};
         const gs_ev_jump *j = &ev->u.jump;
         w_lit(&w, "$GSJMP");
-        n_num(&w, j->t_takeoff_s, 3, 10);
-        n_num(&w, j->flight_time_s, 3, 5);
-        n_num(&w, j->a_px_s2, 1, 8);
-        n_num(&w, j->q_m_per_px, 7, 9);
-        n_num(&w, j->height_m, 3, 6);
-        n_num(&w, j->jump_height_m, 3, 5);
-        n_num(&w, j->takeoff_velocity_m_s, 2, 6);
+        n_fields(&w, j, k_jmp, sizeof k_jmp / sizeof k_jmp[0]);
         n_u32(&w, j->n_samples);
         w_lit(&w, j->accepted ? ",A" : ",R");
         w_raw(&w, ",", 1);
@@ -429,10 +443,10 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
     case GS_EV_HEIGHT:
     case GS_EV_SUMMARY: {
         const gs_ev_height *h = &ev->u.height;
+        static const nmea_field k_hgt[] = {NF(gs_ev_height, height_m, 4, 12), NF(gs_ev_height, ci95_lo_m, 4, 12),
+                                           NF(gs_ev_height, ci95_hi_m, 4, 12)};
         w_lit(&w, ev->type == GS_EV_HEIGHT ? "$GSHGT" : "$GSSUM");
-        n_num(&w, h->height_m, 4, 12);
-        n_num(&w, h->ci95_lo_m, 4, 12);
-        n_num(&w, h->ci95_hi_m, 4, 12);
+        n_fields(&w, h, k_hgt, 3);
         n_u32(&w, h->n_jumps);
         if (ev->type == GS_EV_SUMMARY) n_u32(&w, h->n_rejected);
         break;
@@ -447,13 +461,13 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
             char c = (char)(e->reason[0] >= 'a' && e->reason[0] <= 'z' ? e->reason[0] - 'a' + 'A' : '_');
             w_raw(&w, &c, 1);  /* A absence, N new_body, E end_of_stream */
         }
-        n_num(&w, e->t_start_s, 3, 10);
-        n_num(&w, e->t_end_s, 3, 10);
-        n_num(&w, e->stature_m, 3, 6);
+        static const nmea_field k_ses_t[] = {NF(gs_ev_session, t_start_s, 3, 10), NF(gs_ev_session, t_end_s, 3, 10),
+                                             NF(gs_ev_session, stature_m, 3, 6)};
+        static const nmea_field k_ses_j[] = {NF(gs_ev_session, best_jump_m, 3, 5), NF(gs_ev_session, mean_jump_m, 3, 5),
+                                             NF(gs_ev_session, mean_flight_s, 3, 5)};
+        n_fields(&w, e, k_ses_t, 3);
         n_num(&w, (double)e->n_jumps, 0, 3);
-        n_num(&w, e->best_jump_m, 3, 5);
-        n_num(&w, e->mean_jump_m, 3, 5);
-        n_num(&w, e->mean_flight_s, 3, 5);
+        n_fields(&w, e, k_ses_j, 3);
         break;
     }
     case GS_EV_WARNING: {
