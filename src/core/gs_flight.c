@@ -953,8 +953,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     /* keypoint noise, not motion: judged while nearly still (contact phases of a
      * jump series would otherwise pass for noise) */
     gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
-    gs_real sz_now = size_ref(f, s);
-    bool still = isfinite(speed) && (!isfinite(sz_now) || speed < STAND_SPEED_REL * sz_now);
+    /* size_ref(f, s) again would be sz: nothing between changes what it reads */
+    bool still = isfinite(speed) && (!isfinite(sz) || speed < STAND_SPEED_REL * sz);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
