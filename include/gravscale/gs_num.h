@@ -8,8 +8,9 @@
 /* Parse exactly s[0..len) as a decimal number: optional sign, digits, optional
  * '.' and digits, optional exponent (e/E, sign, digits). No spaces, no hex, no
  * "nan"/"inf". Returns false (out untouched) on any syntax error or when the
- * value overflows a double. Result within 1 ulp of the correctly rounded value
- * for up to 19 significant digits. */
+ * value overflows a double. The result is correctly rounded (round half to
+ * even, subnormals included: the same double as a correct strtod) for any
+ * number of digits. */
 bool gs_num_parse(const char *s, size_t len, double *out);
 
 /* The same syntax, but numbers beyond the fast exact cases (more than 19
@@ -30,7 +31,10 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals);
 
 /* Format a finite v with `sig` (1..15) significant digits, in plain notation
  * when 1e-4 <= |v| < 1e15, otherwise as d.ddde-XX; trailing zeros trimmed.
- * The text is a valid JSON number. Same return convention as above. */
+ * Rounded half away from zero, except where that would exceed the double range
+ * (near DBL_MAX the digits are cut: 1.79e308 to 1 digit is "1e+308", not "2e+308"),
+ * so the text always parses back to a finite double. The text is a valid JSON
+ * number. Same return convention as above. */
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig);
 
 #endif

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "gs_features.h"
 #include "gs_math.h"
 
 #define GS_VERSION "0.1.0"

@@ -19,6 +19,7 @@ enum {
     K_N
 };
 
+#if GS_WITH_POSE
 /* BlazePose-33 index of each canonical keypoint (eye = the eye centre, 2/5). */
 static const uint8_t k_blaze_index[K_N] = {
     0, 2, 5, 7, 8,
@@ -27,6 +28,7 @@ static const uint8_t k_blaze_index[K_N] = {
     29, 30, 31, 32,
     17, 18, 19, 20
 };
+#endif
 
 /* ---- segment tables --------------------------------------------------------- */
 
@@ -102,6 +104,7 @@ static const seg_table k_tables[3] = {
 
 #define RAD_TO_DEG 57.29577951308232f
 
+#if GS_WITH_POSE /* the skeleton model (gs_features.h); a point needs none of it */
 /* ---- small vector helpers ---------------------------------------------------- */
 
 typedef struct {
@@ -176,9 +179,9 @@ static void load(frame *f, gs_layout layout, float min_conf, const gs_kp *kp)
         f->c[k] = 0.0f;
         f->p[k] = (vec2){ NAN, NAN };
         int src = -1;
-        if (layout == GS_LAYOUT_COCO17) {
+        if (GS_WITH_COCO17 && (!GS_WITH_BLAZEPOSE33 || layout == GS_LAYOUT_COCO17)) {
             src = k < 17 ? k : -1;
-        } else if (layout == GS_LAYOUT_BLAZEPOSE33) {
+        } else if (GS_WITH_BLAZEPOSE33) {
             src = k_blaze_index[k];
         }
         if (src < 0) {
@@ -465,14 +468,17 @@ static float upright_score(const frame *f, bool have_trunk, vec2 s, vec2 p, bool
     return min_nan(knee, other);
 }
 
+#endif /* GS_WITH_POSE */
+
 /* ---- public ---------------------------------------------------------------------- */
 
 size_t gs_layout_kp_count(gs_layout layout)
 {
     switch (layout) {
+    /* a layout left out of the build (gs_features.h) is unknown */
     case GS_LAYOUT_POINT: return 1;
-    case GS_LAYOUT_COCO17: return 17;
-    case GS_LAYOUT_BLAZEPOSE33: return 33;
+    case GS_LAYOUT_COCO17: return GS_WITH_COCO17 ? 17u : 0u;
+    case GS_LAYOUT_BLAZEPOSE33: return GS_WITH_BLAZEPOSE33 ? 33u : 0u;
     default: return 0;
     }
 }
@@ -525,10 +531,10 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         }
         return GS_OK;
     }
-
+#if GS_WITH_POSE
     const seg_table *tb = &k_tables[table];
     const float total = table_total_pct(tb);
-    const bool blaze = layout == GS_LAYOUT_BLAZEPOSE33;
+    const bool blaze = GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33);
     frame f;
     load(&f, layout, min_conf, kp);
 
@@ -633,6 +639,7 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         out->x_px = out->y_px = NAN;
         out->w = 0.0f;
     }
+#endif
     return GS_OK;
 }
 

@@ -283,7 +283,7 @@ void gs_core_config_default(gs_core_config *c)
     c->landing_latency_s = 0.2f;
     c->session_absence_s = 2.5f;
     c->session_new_body_rel = 0.12f;
-    c->format = GS_FMT_JSON;
+    c->format = GS_WITH_JSON ? GS_FMT_JSON : GS_FMT_NMEA; /* the one built in (gs_features.h) */
 }
 
 static void range_msg(char *msg, size_t cap, const num_key *k)

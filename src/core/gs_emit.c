@@ -28,7 +28,15 @@ static void w_raw(gs_w *w, const char *s, size_t n)
     w->len += n;
 }
 
-static void w_lit(gs_w *w, const char *s) { w_raw(w, s, strlen(s)); }
+/* byte by byte, as w_raw would (one byte kept for the NUL): a counting loop
+ * would become a strlen call, which a device build need not link (220 B) */
+static void w_lit(gs_w *w, const char *s)
+{
+    for (; *s && w->ok; s++) {
+        if (w->len + 2u > w->cap) w->ok = false;
+        else w->buf[w->len++] = *s;
+    }
+}
 
 static void w_u32(gs_w *w, uint32_t v)
 {
@@ -140,49 +148,86 @@ static void w_warnings(gs_w *w, uint32_t bits)
     w_lit(w, "]");
 }
 
+/* An event's numbers as a table: the text before the value (key and separator)
+ * and where the value is. One loop writes them all (the hand-written sequence of
+ * calls cost about 20 bytes of code per field). */
+enum { F_U32 = 0xFF, F_SIG = 0x10 }; /* kind: 0..9 fixed decimals, F_SIG + n significant digits */
+typedef struct {
+    const char *key;
+    uint8_t off;  /* offsetof the double or uint32_t field */
+    uint8_t kind;
+} json_field;
+
+#define JF(type, field, key, kind) {key, (uint8_t)offsetof(type, field), kind}
+_Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "json_field.off is 8 bits");
+
+static void w_fields(gs_w *w, const void *base, const json_field *t, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        const char *p = (const char *)base + t[i].off;
+        w_lit(w, t[i].key);
+        if (t[i].kind == F_U32) {
+            uint32_t v;
+            memcpy(&v, p, sizeof v);
+            w_u32(w, v);
+        } else {
+            double v;
+            memcpy(&v, p, sizeof v);
+            if (t[i].kind >= F_SIG) w_sig(w, v, t[i].kind - F_SIG);
+            else w_fixed(w, v, t[i].kind);
+        }
+    }
+}
+
+static const json_field k_jump_fields[] = {
+    JF(gs_ev_jump, track, "{\"event\":\"jump\",\"track\":", F_U32),
+    JF(gs_ev_jump, index, ",\"index\":", F_U32),
+    JF(gs_ev_jump, t_takeoff_s, ",\"t_takeoff_s\":", 4),
+    JF(gs_ev_jump, t_land_s, ",\"t_land_s\":", 4),
+    JF(gs_ev_jump, flight_time_s, ",\"flight_time_s\":", 4),
+    JF(gs_ev_jump, t_apex_s, ",\"t_apex_s\":", 4),
+    JF(gs_ev_jump, a_px_s2, ",\"a_px_s2\":", F_SIG + 6),
+    JF(gs_ev_jump, a_px_se_s2, ",\"a_px_se_s2\":", F_SIG + 6),
+    JF(gs_ev_jump, g_dir_deg, ",\"g_dir_deg\":", 2),
+    JF(gs_ev_jump, q_m_per_px, ",\"q_m_per_px\":", F_SIG + 6),
+    JF(gs_ev_jump, size_px, ",\"size_px\":", 2),
+    JF(gs_ev_jump, height_m, ",\"height_m\":", 4),
+    JF(gs_ev_jump, height_se_m, ",\"height_se_m\":", 4),
+    JF(gs_ev_jump, jump_height_m, ",\"jump_height_m\":", 4),
+    JF(gs_ev_jump, takeoff_velocity_m_s, ",\"takeoff_velocity_m_s\":", 3),
+    JF(gs_ev_jump, n_samples, ",\"n_samples\":", F_U32),
+    JF(gs_ev_jump, n_outliers, ",\"n_outliers\":", F_U32),
+    JF(gs_ev_jump, rms_px, ",\"rms_px\":", 3),
+};
+
 static void json_jump(gs_w *w, const gs_ev_jump *j)
 {
-    w_lit(w, "{\"event\":\"jump\",\"track\":");
-    w_u32(w, j->track);
-    w_lit(w, ",\"index\":");
-    w_u32(w, j->index);
-    w_lit(w, ",\"t_takeoff_s\":");
-    w_fixed(w, j->t_takeoff_s, 4);
-    w_lit(w, ",\"t_land_s\":");
-    w_fixed(w, j->t_land_s, 4);
-    w_lit(w, ",\"flight_time_s\":");
-    w_fixed(w, j->flight_time_s, 4);
-    w_lit(w, ",\"t_apex_s\":");
-    w_fixed(w, j->t_apex_s, 4);
-    w_lit(w, ",\"a_px_s2\":");
-    w_sig(w, j->a_px_s2, 6);
-    w_lit(w, ",\"a_px_se_s2\":");
-    w_sig(w, j->a_px_se_s2, 6);
-    w_lit(w, ",\"g_dir_deg\":");
-    w_fixed(w, j->g_dir_deg, 2);
-    w_lit(w, ",\"q_m_per_px\":");
-    w_sig(w, j->q_m_per_px, 6);
-    w_lit(w, ",\"size_px\":");
-    w_fixed(w, j->size_px, 2);
-    w_lit(w, ",\"height_m\":");
-    w_fixed(w, j->height_m, 4);
-    w_lit(w, ",\"height_se_m\":");
-    w_fixed(w, j->height_se_m, 4);
-    w_lit(w, ",\"jump_height_m\":");
-    w_fixed(w, j->jump_height_m, 4);
-    w_lit(w, ",\"takeoff_velocity_m_s\":");
-    w_fixed(w, j->takeoff_velocity_m_s, 3);
-    w_lit(w, ",\"n_samples\":");
-    w_u32(w, j->n_samples);
-    w_lit(w, ",\"n_outliers\":");
-    w_u32(w, j->n_outliers);
-    w_lit(w, ",\"rms_px\":");
-    w_fixed(w, j->rms_px, 3);
+    w_fields(w, j, k_jump_fields, sizeof k_jump_fields / sizeof k_jump_fields[0]);
     w_lit(w, j->accepted ? ",\"accepted\":true,\"reason\":" : ",\"accepted\":false,\"reason\":");
     w_jstr(w, j->accepted ? NULL : gs_reject_reason_name(j->reason));
     w_warnings(w, j->warnings);
     w_lit(w, "}\n");
 }
+
+/* ,"ci95_m":[lo,hi], or null: an interval with an unknown end is no interval */
+static void w_ci95(gs_w *w, double mid, double lo, double hi)
+{
+    w_lit(w, ",\"ci95_m\":");
+    if (isfinite(lo) && isfinite(hi) && isfinite(mid)) {
+        w_raw(w, "[", 1);
+        w_fixed(w, lo, 4);
+        w_raw(w, ",", 1);
+        w_fixed(w, hi, 4);
+        w_raw(w, "]", 1);
+    } else {
+        w_lit(w, "null");
+    }
+}
+
+static const json_field k_height_counts[] = {
+    JF(gs_ev_height, n_jumps, ",\"n_jumps\":", F_U32),
+    JF(gs_ev_height, n_rejected, ",\"n_rejected\":", F_U32),
+};
 
 static void json_height(gs_w *w, const gs_ev_height *h, bool summary)
 {
@@ -190,62 +235,38 @@ static void json_height(gs_w *w, const gs_ev_height *h, bool summary)
     w_u32(w, h->track);
     w_lit(w, ",\"height_m\":");
     w_fixed(w, h->height_m, 4);
-    w_lit(w, ",\"ci95_m\":");
-    /* an interval with an unknown end is no interval */
-    if (isfinite(h->ci95_lo_m) && isfinite(h->ci95_hi_m) && isfinite(h->height_m)) {
-        w_raw(w, "[", 1);
-        w_fixed(w, h->ci95_lo_m, 4);
-        w_raw(w, ",", 1);
-        w_fixed(w, h->ci95_hi_m, 4);
-        w_raw(w, "]", 1);
-    } else {
-        w_lit(w, "null");
-    }
-    w_lit(w, ",\"n_jumps\":");
-    w_u32(w, h->n_jumps);
-    w_lit(w, ",\"n_rejected\":");
-    w_u32(w, h->n_rejected);
+    w_ci95(w, h->height_m, h->ci95_lo_m, h->ci95_hi_m);
+    w_fields(w, h, k_height_counts, 2);
     w_lit(w, "}\n");
 }
 
+static const json_field k_session_head[] = {
+    JF(gs_ev_session, track, "{\"event\":\"session\",\"track\":", F_U32),
+    JF(gs_ev_session, session, ",\"session\":", F_U32),
+};
+static const json_field k_session_times[] = {
+    JF(gs_ev_session, t_start_s, ",\"t_start_s\":", 4),
+    JF(gs_ev_session, t_end_s, ",\"t_end_s\":", 4),
+    JF(gs_ev_session, stature_m, ",\"stature_m\":", 4),
+};
+static const json_field k_session_tail[] = {
+    JF(gs_ev_session, n_jumps, ",\"n_jumps\":", F_U32),
+    JF(gs_ev_session, n_rejected, ",\"n_rejected\":", F_U32),
+    JF(gs_ev_session, best_jump_m, ",\"best_jump_m\":", 4),
+    JF(gs_ev_session, mean_jump_m, ",\"mean_jump_m\":", 4),
+    JF(gs_ev_session, best_flight_s, ",\"best_flight_s\":", 4),
+    JF(gs_ev_session, mean_flight_s, ",\"mean_flight_s\":", 4),
+    JF(gs_ev_session, mean_takeoff_velocity_m_s, ",\"mean_takeoff_velocity_m_s\":", 3),
+};
+
 static void json_session(gs_w *w, const gs_ev_session *e)
 {
-    w_lit(w, "{\"event\":\"session\",\"track\":");
-    w_u32(w, e->track);
-    w_lit(w, ",\"session\":");
-    w_u32(w, e->session);
+    w_fields(w, e, k_session_head, 2);
     w_lit(w, e->ended ? ",\"state\":\"end\",\"reason\":" : ",\"state\":\"start\",\"reason\":");
     w_jstr(w, e->reason);
-    w_lit(w, ",\"t_start_s\":");
-    w_fixed(w, e->t_start_s, 4);
-    w_lit(w, ",\"t_end_s\":");
-    w_fixed(w, e->t_end_s, 4);
-    w_lit(w, ",\"stature_m\":");
-    w_fixed(w, e->stature_m, 4);
-    w_lit(w, ",\"ci95_m\":");
-    if (isfinite(e->ci95_lo_m) && isfinite(e->ci95_hi_m) && isfinite(e->stature_m)) {
-        w_raw(w, "[", 1);
-        w_fixed(w, e->ci95_lo_m, 4);
-        w_raw(w, ",", 1);
-        w_fixed(w, e->ci95_hi_m, 4);
-        w_raw(w, "]", 1);
-    } else {
-        w_lit(w, "null");
-    }
-    w_lit(w, ",\"n_jumps\":");
-    w_u32(w, e->n_jumps);
-    w_lit(w, ",\"n_rejected\":");
-    w_u32(w, e->n_rejected);
-    w_lit(w, ",\"best_jump_m\":");
-    w_fixed(w, e->best_jump_m, 4);
-    w_lit(w, ",\"mean_jump_m\":");
-    w_fixed(w, e->mean_jump_m, 4);
-    w_lit(w, ",\"best_flight_s\":");
-    w_fixed(w, e->best_flight_s, 4);
-    w_lit(w, ",\"mean_flight_s\":");
-    w_fixed(w, e->mean_flight_s, 4);
-    w_lit(w, ",\"mean_takeoff_velocity_m_s\":");
-    w_fixed(w, e->mean_takeoff_velocity_m_s, 3);
+    w_fields(w, e, k_session_times, 3);
+    w_ci95(w, e->stature_m, e->ci95_lo_m, e->ci95_hi_m);
+    w_fields(w, e, k_session_tail, sizeof k_session_tail / sizeof k_session_tail[0]);
     w_lit(w, "}\n");
 }
 
@@ -288,6 +309,7 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
         w_warnings(&w, ev->u.warning.warnings);
         w_lit(&w, "}\n");
         break;
+#if GS_WITH_TRACE /* trace events (gs_features.h): without them, no form (returns 0) */
     case GS_EV_STATE: {
         const gs_ev_state *s = &ev->u.state;
         w_lit(&w, "{\"event\":\"state\",\"t_s\":");
@@ -335,6 +357,7 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
         w_lit(&w, "}\n");
         break;
     }
+#endif
     default: w.ok = false; break;
     }
     return w_finish(&w);
@@ -358,6 +381,21 @@ static void n_num(gs_w *w, double v, int decimals, size_t width)
     }
 }
 
+/* fields of a sentence from a table, as json_field: offset, decimals and width of a double */
+typedef struct {
+    uint8_t off, decimals, width;
+} nmea_field;
+#define NF(type, field, dec, width) {(uint8_t)offsetof(type, field), dec, width}
+
+static void n_fields(gs_w *w, const void *base, const nmea_field *t, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double v;
+        memcpy(&v, (const char *)base + t[i].off, sizeof v);
+        n_num(w, v, t[i].decimals, t[i].width);
+    }
+}
+
 static void n_u32(gs_w *w, uint32_t v)
 {
     w_raw(w, ",", 1);
@@ -370,7 +408,10 @@ static void n_text(gs_w *w, const char *s, size_t max_len)
     w_raw(w, ",", 1);
     for (size_t i = 0; s && s[i] && i < max_len; i++) {
         char c = s[i];
-        if (c < 0x20 || c > 0x7e || strchr("$*,!\\^~", c)) c = '_';
+        /* NMEA's reserved characters (not strchr: no libc search linked for this) */
+        if (c < 0x20 || c > 0x7e || c == '$' || c == '*' || c == ',' || c == '!' || c == '\\' || c == '^' ||
+            c == '~')
+            c = '_';
         w_raw(w, &c, 1);
     }
 }
@@ -382,15 +423,14 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
     switch (ev->type) {
     case GS_EV_JUMP: {
         /* widths: 10+5+8+9+6+5+6+10+1+1 = 61 = 82 - "$GSJMP" - 10 commas - "*HH\r\n" */
+        static const nmea_field k_jmp[] = {
+            NF(gs_ev_jump, t_takeoff_s, 3, 10), NF(gs_ev_jump, flight_time_s, 3, 5),
+            NF(gs_ev_jump, a_px_s2, 1, 8),      NF(gs_ev_jump, q_m_per_px, 7, 9),
+            NF(gs_ev_jump, height_m, 3, 6),     NF(gs_ev_jump, jump_height_m, 3, 5),
+            NF(gs_ev_jump, takeoff_velocity_m_s, 2, 6)};
         const gs_ev_jump *j = &ev->u.jump;
         w_lit(&w, "$GSJMP");
-        n_num(&w, j->t_takeoff_s, 3, 10);
-        n_num(&w, j->flight_time_s, 3, 5);
-        n_num(&w, j->a_px_s2, 1, 8);
-        n_num(&w, j->q_m_per_px, 7, 9);
-        n_num(&w, j->height_m, 3, 6);
-        n_num(&w, j->jump_height_m, 3, 5);
-        n_num(&w, j->takeoff_velocity_m_s, 2, 6);
+        n_fields(&w, j, k_jmp, sizeof k_jmp / sizeof k_jmp[0]);
         n_u32(&w, j->n_samples);
         w_lit(&w, j->accepted ? ",A" : ",R");
         w_raw(&w, ",", 1);
@@ -403,10 +443,10 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
     case GS_EV_HEIGHT:
     case GS_EV_SUMMARY: {
         const gs_ev_height *h = &ev->u.height;
+        static const nmea_field k_hgt[] = {NF(gs_ev_height, height_m, 4, 12), NF(gs_ev_height, ci95_lo_m, 4, 12),
+                                           NF(gs_ev_height, ci95_hi_m, 4, 12)};
         w_lit(&w, ev->type == GS_EV_HEIGHT ? "$GSHGT" : "$GSSUM");
-        n_num(&w, h->height_m, 4, 12);
-        n_num(&w, h->ci95_lo_m, 4, 12);
-        n_num(&w, h->ci95_hi_m, 4, 12);
+        n_fields(&w, h, k_hgt, 3);
         n_u32(&w, h->n_jumps);
         if (ev->type == GS_EV_SUMMARY) n_u32(&w, h->n_rejected);
         break;
@@ -421,13 +461,13 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
             char c = (char)(e->reason[0] >= 'a' && e->reason[0] <= 'z' ? e->reason[0] - 'a' + 'A' : '_');
             w_raw(&w, &c, 1);  /* A absence, N new_body, E end_of_stream */
         }
-        n_num(&w, e->t_start_s, 3, 10);
-        n_num(&w, e->t_end_s, 3, 10);
-        n_num(&w, e->stature_m, 3, 6);
+        static const nmea_field k_ses_t[] = {NF(gs_ev_session, t_start_s, 3, 10), NF(gs_ev_session, t_end_s, 3, 10),
+                                             NF(gs_ev_session, stature_m, 3, 6)};
+        static const nmea_field k_ses_j[] = {NF(gs_ev_session, best_jump_m, 3, 5), NF(gs_ev_session, mean_jump_m, 3, 5),
+                                             NF(gs_ev_session, mean_flight_s, 3, 5)};
+        n_fields(&w, e, k_ses_t, 3);
         n_num(&w, (double)e->n_jumps, 0, 3);
-        n_num(&w, e->best_jump_m, 3, 5);
-        n_num(&w, e->mean_jump_m, 3, 5);
-        n_num(&w, e->mean_flight_s, 3, 5);
+        n_fields(&w, e, k_ses_j, 3);
         break;
     }
     case GS_EV_WARNING: {
@@ -460,9 +500,14 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
 
 size_t gs_emit(gs_format fmt, const gs_event *ev, char *buf, size_t cap)
 {
+    /* a format left out of the build (gs_features.h) writes nothing */
     switch (fmt) {
-    case GS_FMT_JSON: return gs_emit_json(ev, buf, cap);
-    case GS_FMT_NMEA: return gs_emit_nmea(ev, buf, cap);
+    case GS_FMT_JSON:
+        if (GS_WITH_JSON) return gs_emit_json(ev, buf, cap);
+        break;
+    case GS_FMT_NMEA:
+        if (GS_WITH_NMEA) return gs_emit_nmea(ev, buf, cap);
+        break;
     }
     if (buf && cap) buf[0] = '\0';
     return 0;

@@ -194,7 +194,7 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out)
         const char *name = gs_fit_method_name(all[i]);
         for (k = 0; k < len && name[k] != '\0' && name[k] == s[k]; k++) {
         }
-        if (k == len && name[k] == '\0') {
+        if (k == len && name[k] == '\0' && (GS_WITH_RANSAC || all[i] != GS_FIT_RANSAC)) {
             *out = all[i];
             return true;
         }
@@ -672,8 +672,8 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     case GS_FIT_IRLS:
         st = fit_irls(&wn, m, floor_px, keep, out);
         break;
-    case GS_FIT_RANSAC:
-        st = fit_ransac(&wn, m, floor_px, keep, out);
+    case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
+        st = GS_WITH_RANSAC ? fit_ransac(&wn, m, floor_px, keep, out) : GS_EINVAL;
         break;
     default:
         st = GS_EINVAL;

@@ -124,7 +124,7 @@ const char *gs_flight_state_name(gs_flight_state s)
 static void set_state(gs_flight *f, gs_flight_state to, double t_s)
 {
     if (f->state == to) return;
-    if (f->trace) {
+    if (GS_WITH_TRACE && f->trace) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
         ev.type = GS_EV_STATE;
@@ -139,7 +139,7 @@ static void set_state(gs_flight *f, gs_flight_state to, double t_s)
 static void trace_fit(const gs_flight *f, const char *purpose, double t0, double t1,
                       const gs_fit_result *r)
 {
-    if (!f->trace) return;
+    if (!GS_WITH_TRACE || !f->trace) return;
     gs_event ev;
     memset(&ev, 0, sizeof ev);
     ev.type = GS_EV_FIT;
@@ -275,6 +275,9 @@ static double frame_dt(const gs_flight *f)
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
+/* a rigid object (the point layout): always, where no skeleton layout is built in
+ * (gs_features.h), so the standing tracker is left out of such builds */
+#define IS_RIGID(f) (!GS_WITH_POSE || (f)->rigid)
 
 /* Could this fit be free fall? Acceleration roughly along the expected gravity
  * direction, and of a size that makes the object's size plausible (loosely:
@@ -305,7 +308,7 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
 /* the object's size in px for gating: standing stature, or the rigid object's latest size */
 static gs_real gate_size(const gs_flight *f, uint64_t idx)
 {
-    if (f->rigid) {
+    if (IS_RIGID(f)) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
         return s && isfinite(s->size_px) ? (gs_real)s->size_px : NAN;
@@ -766,7 +769,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     j->reason = GS_REJ_NONE;
 
     gs_real size_se = NAN;
-    gs_real size = f->rigid ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
+    gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
 
     if (st != GS_OK) {
@@ -873,7 +876,7 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
 static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed)
 {
     if (!isfinite(speed)) return;
-    if (f->rigid || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
+    if (IS_RIGID(f) || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
     if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
     if (!isfinite(f->still_since)) f->still_since = s->t_s;
@@ -919,7 +922,7 @@ void gs_flight_forget_body(gs_flight *f)
 
 static gs_real size_ref(const gs_flight *f, const gs_sample_full *s)
 {
-    if (f->stand_n > 0) {
+    if (!IS_RIGID(f) && f->stand_n > 0) { /* a rigid object has no standing sizes */
         uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
         return f->stand_size[i];
     }
@@ -950,8 +953,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     /* keypoint noise, not motion: judged while nearly still (contact phases of a
      * jump series would otherwise pass for noise) */
     gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
-    gs_real sz_now = size_ref(f, s);
-    bool still = isfinite(speed) && (!isfinite(sz_now) || speed < STAND_SPEED_REL * sz_now);
+    /* size_ref(f, s) again would be sz: nothing between changes what it reads */
+    bool still = isfinite(speed) && (!isfinite(sz) || speed < STAND_SPEED_REL * sz);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {

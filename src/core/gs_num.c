@@ -1,6 +1,6 @@
 /* gs_num.c - decimal parsing and formatting without strtod/printf.
- * Parsing: a fast path (<= 19 digits in a uint64, exact powers of ten) and an
- * exact big-integer path for the rest. Formatting: exact decimal digits of the
+ * Parsing: a fast path (a mantissa <= 2^53 times an exact power of ten: one
+ * rounding) and an exact big-integer path for the rest: correctly rounded. Formatting: exact decimal digits of the
  * binary value from a big integer, rounded half away from zero.
  * double: it is the number format of the lines (event fields are double). */
 #include "gravscale/gs_num.h"
@@ -414,8 +414,10 @@ static bool parse_impl(const char *s, size_t len, double *out, bool exact)
                     return true;
                 }
             }
-        } else if (e10 >= -22 && e10 <= 22) {
-            /* 17-19 digits: two roundings, within 1 ulp (the header's promise) */
+        } else if (!exact && e10 >= -22 && e10 <= 22) {
+            /* 17-19 digits in the scaled parser: two roundings, within 1 ulp. The
+             * exact parser takes the big-integer path: (double)m rounds once
+             * already (m > 2^53), so m * 10^e10 may land 1 ulp off. */
             double r = (double)m;
             r = e10 < 0 ? r / k_pow10_dbl[-e10] : r * k_pow10_dbl[e10];
             *out = neg ? -r : r;
@@ -541,20 +543,20 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     if (!isfinite(v) || fabs(v) >= 1e15 || decimals < 0 || decimals > 9)
         return put_fail(buf, cap);
-    char dig[32]; /* the integer round(|v| * 10^decimals), most significant first */
+    char buf_dig[32]; /* the integer round(|v| * 10^decimals), most significant first */
+    char *dig = buf_dig + 1;
     int nd = 0;
     if (v != 0.0) {
         gs_dec d;
         dec_expand(fabs(v), &d);
         int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
         if (count >= 0) {
-            int carry = dec_round(&d, count, dig + 1);
-            if (carry) {
+            int carry = dec_round(&d, count, dig);
+            nd = count;
+            if (carry) { /* a new leading 1 in front (no memmove linked) */
+                dig = buf_dig;
                 dig[0] = 1;
                 nd = count + 1;
-            } else {
-                memmove(dig, dig + 1, (size_t)count);
-                nd = count;
             }
         }
     }
@@ -592,6 +594,15 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
         for (int i = 1; i < sig; i++) dig[i] = 0;
         k++;
     }
+    /* Near the largest double, rounding up can give a decimal that no double
+     * is nearest to (1.79e308 to 1 digit: 2e+308; DBL_MAX to 15: 1.79769313486232e+308,
+     * beyond DBL_MAX + half an ulp): it would parse back as an overflow. There
+     * the digits are cut instead of rounded up, the nearest decimal of `sig` digits
+     * that is still a finite double (1e+308, 1.79769313486231e+308). Below 10^308,
+     * and for DBL_MAX's first 16 digits, cut and round-up limit are the same. */
+    static const char k_max_dig[16] = {1, 7, 9, 7, 6, 9, 3, 1, 3, 4, 8, 6, 2, 3, 1, 5};
+    if (k == 308 && memcmp(dig, k_max_dig, (size_t)sig) > 0)
+        for (int i = 0; i < sig; i++) dig[i] = (char)dec_digit(&d, i);
     int nk = sig;
     while (nk > 1 && dig[nk - 1] == 0) nk--;
     char t[48];

@@ -22,7 +22,7 @@ static void on_flight_event(void *ctx, const gs_event *ev)
     gs_pipeline *p = (gs_pipeline *)ctx;
     if (p->on_event) p->on_event(p->ctx, ev);
     if (ev->type != GS_EV_JUMP) return;
-    if (p->sessions) gs_session_jump(&p->session, &ev->u.jump);
+    if (GS_WITH_POSE && p->sessions) gs_session_jump(&p->session, &ev->u.jump);
     if (ev->u.jump.accepted) {
         gs_agg_add(&p->agg, ev->u.jump.height_m, ev->u.jump.height_se_m);
         gs_event h;
@@ -56,8 +56,8 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     gs_status st = gs_ring_init(&p->ring, samples, cap);
     if (st != GS_OK) return st;
     gs_agg_init(&p->agg);
-    p->sessions = layout != GS_LAYOUT_POINT;
-    gs_session_init(&p->session, (double)cfg->session_absence_s, (double)cfg->session_new_body_rel);
+    p->sessions = GS_WITH_POSE && layout != GS_LAYOUT_POINT;
+    if (GS_WITH_POSE) gs_session_init(&p->session, (double)cfg->session_absence_s, (double)cfg->session_new_body_rel);
     return gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
                           on_flight_event, p);
 }
@@ -120,7 +120,7 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
     if (st != GS_OK) return st;
     p->last_t_s = s->t_s;
     p->n_frames++;
-    if (p->flight.trace && p->on_event) {
+    if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
         ev.type = GS_EV_SAMPLE;
@@ -133,7 +133,7 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
         p->on_event(p->ctx, &ev);
     }
     gs_flight_update(&p->flight);
-    if (p->sessions) track_session(p, s);
+    if (GS_WITH_POSE && p->sessions) track_session(p, s);
     return GS_OK;
 }
 
@@ -177,7 +177,7 @@ gs_status gs_pipeline_flush(gs_pipeline *p)
     if (p->finished) return GS_ESTATE;
     gs_flight_finish(&p->flight);
     p->finished = true;
-    if (p->sessions && p->session.open) {
+    if (GS_WITH_POSE && p->sessions && p->session.open) {
         emit_session(p, true, "end_of_stream");
         gs_session_close(&p->session);
     }

@@ -47,11 +47,12 @@ const char *gs_format_name(gs_format f)
 bool gs_format_from_name(const char *s, size_t len, gs_format *out)
 {
     if (!s || !out || len != 4) return false;
-    if (memcmp(s, "json", 4) == 0) {
+    /* a format left out of the build (gs_features.h) is an unknown name */
+    if (GS_WITH_JSON && memcmp(s, "json", 4) == 0) {
         *out = GS_FMT_JSON;
         return true;
     }
-    if (memcmp(s, "nmea", 4) == 0) {
+    if (GS_WITH_NMEA && memcmp(s, "nmea", 4) == 0) {
         *out = GS_FMT_NMEA;
         return true;
     }

@@ -49,19 +49,40 @@ static float bounce_m(float t)
     return v0 * x - 0.5f * g * x * x;
 }
 
+#if GS_WITH_POSE
+/* the skeleton's layout: COCO-17 when built in (gs_features.h), else BlazePose-33 */
+#define FW_POSE_LAYOUT (GS_WITH_COCO17 ? GS_LAYOUT_COCO17 : GS_LAYOUT_BLAZEPOSE33)
+
 static void push_pose(double t, float y_off_px)
 {
-    /* a standing skeleton about 530 px tall, lifted by y_off_px */
+    /* a standing skeleton about 530 px tall, lifted by y_off_px (COCO-17 order) */
     static const float k_y[17] = {60, 52, 52, 56, 56, 110, 110, 190, 190, 260, 260, 290, 290, 400, 400, 530, 530};
     static const float k_x[17] = {0, -6, 6, -14, 14, -40, 40, -48, 48, -50, 50, -22, 22, -24, 24, -24, 24};
-    gs_kp kp[17];
+    gs_kp kp[GS_WITH_COCO17 ? 17 : 33];
     for (int i = 0; i < 17; i++) {
         kp[i].x_px = 640.0f + k_x[i];
         kp[i].y_px = 100.0f + k_y[i] - y_off_px;
         kp[i].c = 0.9f;
     }
+#if !GS_WITH_COCO17
+    {
+        /* the same body in BlazePose-33: its index of each COCO keypoint; the inner
+         * and outer eyes, mouth and hand points unseen; heels and toes by the ankles */
+        static const uint8_t k_to_blaze[17] = {0, 2, 5, 7, 8, 11, 12, 13, 14, 15, 16, 23, 24, 25, 26, 27, 28};
+        gs_kp coco[17];
+        memcpy(coco, kp, sizeof coco);
+        for (int i = 0; i < 33; i++) kp[i] = (gs_kp){0.0f, 0.0f, 0.0f};
+        for (int i = 0; i < 17; i++) kp[k_to_blaze[i]] = coco[i];
+        for (int s = 0; s < 2; s++) {
+            const gs_kp *ank = &coco[15 + s];
+            kp[29 + s] = (gs_kp){ank->x_px - 4.0f, ank->y_px + 12.0f, 0.9f};  /* heel */
+            kp[31 + s] = (gs_kp){ank->x_px + 30.0f, ank->y_px + 14.0f, 0.9f}; /* foot index */
+        }
+    }
+#endif
     g_status |= (uint32_t)gs_pipeline_push_keypoints(&g_pipe, t, kp);
 }
+#endif
 
 uint32_t fw_scenario_run(bool pose, fw_line_fn line)
 {
@@ -80,7 +101,13 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     g_cfg.size_max_m = 2.5f;
     g_status = 0;
 #endif
-    g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, pose ? GS_LAYOUT_COCO17 : GS_LAYOUT_POINT,
+#if GS_WITH_POSE
+    const gs_layout layout = pose ? FW_POSE_LAYOUT : GS_LAYOUT_POINT;
+#else
+    if (pose) return 0u; /* no skeleton layout built in: no skeleton workload */
+    const gs_layout layout = GS_LAYOUT_POINT;
+#endif
+    g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, layout,
                                            g_storage, sizeof g_storage, on_event, NULL);
     const float q_m_per_px = 0.002f;
     for (uint32_t i = 0; i < 6u * (uint32_t)FW_FPS; i++) {
@@ -88,7 +115,9 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
         double t = 1000.0 + (double)i / FW_FPS;
         float h = bounce_m((float)i / (float)FW_FPS);
         if (pose) {
+#if GS_WITH_POSE
             push_pose(t, h / q_m_per_px);
+#endif
         } else {
             g_status |= (uint32_t)gs_pipeline_push_point(&g_pipe, t, 320.0f, 400.0f - h / q_m_per_px, 1.0f, 34.35f);
         }
