@@ -6,9 +6,9 @@
 // frame and where the time went (the program's own stage clocks, written to
 // GS_VIDEO_TIMES by cmd_video.cpp).
 //
-//   bench_pipeline [CLIP] [--program PATH] [--models DIR] [--model lite|full|heavy|all]
+//   bench_pipeline [CLIP] [--program PATH] [--models DIR] [--model lite|full|heavy|all|lite,full]
 //                  [--res 720|1080|both] [--cpus 1|2|both] [--prefetch 0|2|both]
-//                  [--threads auto|1|2] [--frames N] [--repeat N]
+//                  [--threads auto|1|2|auto,1] [--frames N] [--repeat N]
 //
 // CLIP defaults to $GS_SHARED_DIR (else ../shared) /data/real/jumpvision_jumps/
 // cmj_gym_handheld_30fps.mp4 (720 x 1280, 54 frames). Its frames are played
@@ -178,9 +178,9 @@ RunResult run_once(const std::string &program, const std::vector<std::string> &a
 int usage()
 {
     std::fprintf(stderr,
-                 "usage: bench_pipeline [CLIP] [--program PATH] [--models DIR] [--model lite|full|heavy|all]\n"
+                 "usage: bench_pipeline [CLIP] [--program PATH] [--models DIR] [--model lite|full|heavy|all|lite,full]\n"
                  "                      [--res 720|1080|both] [--cpus 1|2|both] [--prefetch 0|2|both]\n"
-                 "                      [--threads auto|1|2] [--frames N] [--repeat N]\n");
+                 "                      [--threads auto|1|2|auto,1] [--frames N] [--repeat N]\n");
     return 2;
 }
 
@@ -219,8 +219,14 @@ int main(int argc, char **argv)
     }
     std::vector<std::string> models;
     if (model_arg == "all") models = {"lite", "full", "heavy"};
-    else if (model_arg == "lite" || model_arg == "full" || model_arg == "heavy") models = {model_arg};
-    else return usage();
+    else {  // one model or a comma-separated list
+        std::stringstream ss(model_arg);
+        std::string m;
+        while (std::getline(ss, m, ','))
+            if (m == "lite" || m == "full" || m == "heavy") models.push_back(m);
+            else return usage();
+        if (models.empty()) return usage();
+    }
     std::vector<int> heights, cpus, prefetch;
     if (res_arg == "both") heights = {720, 1080};
     else if (res_arg == "720" || res_arg == "1080") heights = {std::atoi(res_arg.c_str())};
@@ -231,7 +237,15 @@ int main(int argc, char **argv)
     if (prefetch_arg == "both") prefetch = {0, 2};
     else if (prefetch_arg == "0" || prefetch_arg == "2") prefetch = {std::atoi(prefetch_arg.c_str())};
     else return usage();
-    if (threads_arg != "auto" && threads_arg != "1" && threads_arg != "2") return usage();
+    std::vector<std::string> threads;  // OpenCV threads: auto (OpenCV's default: the CPUs allowed), 1, 2
+    {
+        std::stringstream ss(threads_arg);
+        std::string t;
+        while (std::getline(ss, t, ','))
+            if (t == "auto" || t == "1" || t == "2") threads.push_back(t);
+            else return usage();
+        if (threads.empty()) return usage();
+    }
     if (access(program.c_str(), X_OK) != 0) {
         std::fprintf(stderr, "bench_pipeline: %s: not a program (--program PATH)\n", program.c_str());
         return 1;
@@ -267,13 +281,15 @@ int main(int argc, char **argv)
         std::printf("# %dp clip written in %.1f s: %s\n", h, now_s() - t0, path.c_str());
         std::fflush(stdout);
         for (const std::string &m : models) {
-            for (int c : cpus) {
+            for (int c : cpus)
+            for (const std::string &thr : threads) {
+                if (c == 1 && thr == "1" && threads.size() > 1) continue;  // auto is 1 on one CPU
                 std::string seq_out;
                 for (int pf : prefetch) {
                     std::vector<std::string> args = {"video", path, "--detector", "pose", "--model", m,
                                                      "--prefetch", std::to_string(pf)};
                     if (!models_dir.empty()) args.insert(args.end(), {"--models", models_dir});
-                    if (threads_arg != "auto") args.insert(args.end(), {"--threads", threads_arg});
+                    if (thr != "auto") args.insert(args.end(), {"--threads", thr});
                     RunResult best;
                     double best_fps = -1;
                     for (int k = 0; k < repeat; k++) {
