@@ -8,7 +8,7 @@
 //
 //   bench_pipeline [CLIP] [--program PATH] [--models DIR] [--model lite|full|heavy|all|lite,full]
 //                  [--res 720|1080|both] [--cpus 1|2|both] [--prefetch 0|2|both]
-//                  [--threads auto|1|2|auto,1] [--frames N] [--repeat N]
+//                  [--threads auto|1|2|auto,1] [--frames N] [--repeat N] [--wait-idle S]
 //
 // CLIP defaults to $GS_SHARED_DIR (else ../shared) /data/real/jumpvision_jumps/
 // cmj_gym_handheld_30fps.mp4 (720 x 1280, 54 frames). Its frames are played
@@ -20,7 +20,12 @@
 // loop time); "e2e" counts the whole process from exec to exit. CPU ms per
 // frame is the process's (all threads, children's rusage) over all frames
 // and does not depend on the other load of the machine; wall times do: the
-// load average (1 min) is printed before and after each row. Each row is the
+// load average (1 min) is printed before and after each row, and "others":
+// how many CPUs the machine's other processes kept busy during the run
+// (/proc/stat's busy time less this run's CPU time, over its wall time; 0 on
+// an idle machine, 2 when they took both CPUs of this one). --wait-idle S
+// waits before each run, up to S seconds, for a second in which the others
+// use less than a quarter of a CPU. Each row is the
 // best (highest fps) of --repeat runs (default 1). The outputs of the
 // sequential and the prefetching runs of one clip and model are compared
 // byte for byte ("same").
@@ -72,6 +77,33 @@ double load1()
         std::fclose(f);
     }
     return l;
+}
+
+// CPU time the whole machine spent busy, all processes (containers included), s
+double machine_busy_s()
+{
+    unsigned long long v[8] = {0};
+    FILE *f = std::fopen("/proc/stat", "r");
+    if (!f) return NAN;
+    int n = std::fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                        &v[6], &v[7]);
+    std::fclose(f);
+    if (n != 8) return NAN;
+    // user nice system idle iowait irq softirq steal: all but idle and iowait
+    return static_cast<double>(v[0] + v[1] + v[2] + v[5] + v[6] + v[7]) / sysconf(_SC_CLK_TCK);
+}
+
+// Waits (up to max_s) for one second in which the other processes use less
+// than a quarter of a CPU; returns the CPUs they used in the last second.
+double wait_idle(double max_s)
+{
+    double t0 = now_s(), used = NAN;
+    do {
+        double b0 = machine_busy_s(), w0 = now_s();
+        usleep(1000000);
+        used = (machine_busy_s() - b0) / (now_s() - w0);
+    } while (!(used < 0.25) && now_s() - t0 < max_s);
+    return used;
 }
 
 std::string self_dir()
@@ -130,6 +162,7 @@ bool write_clip(const std::vector<cv::Mat> &frames, double scale, int n_frames, 
 struct RunResult {
     bool ok = false;
     double wall_s = 0, cpu_s = 0, load_before = NAN, load_after = NAN;
+    double others = NAN;  // CPUs the other processes of the machine used during the run
     std::string times;  // the GS_VIDEO_TIMES line
     std::string out;    // stdout
 };
@@ -141,6 +174,7 @@ RunResult run_once(const std::string &program, const std::vector<std::string> &a
     std::string times_path = tmp + "/times.jsonl", out_path = tmp + "/out.jsonl", err_path = tmp + "/err.txt";
     std::remove(times_path.c_str());
     r.load_before = load1();
+    double busy0 = machine_busy_s();
     double t0 = now_s();
     pid_t pid = fork();
     if (pid < 0) return r;
@@ -168,6 +202,7 @@ RunResult run_once(const std::string &program, const std::vector<std::string> &a
     r.wall_s = now_s() - t0;
     r.cpu_s = ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
     r.load_after = load1();
+    r.others = std::max(0.0, (machine_busy_s() - busy0 - r.cpu_s) / r.wall_s);
     r.ok = WIFEXITED(st) && WEXITSTATUS(st) == 0;
     if (!r.ok) std::fprintf(stderr, "bench_pipeline: the program failed (status %d): %s\n", st, read_all(err_path).c_str());
     r.times = read_all(times_path);
@@ -180,7 +215,7 @@ int usage()
     std::fprintf(stderr,
                  "usage: bench_pipeline [CLIP] [--program PATH] [--models DIR] [--model lite|full|heavy|all|lite,full]\n"
                  "                      [--res 720|1080|both] [--cpus 1|2|both] [--prefetch 0|2|both]\n"
-                 "                      [--threads auto|1|2|auto,1] [--frames N] [--repeat N]\n");
+                 "                      [--threads auto|1|2|auto,1] [--frames N] [--repeat N] [--wait-idle S]\n");
     return 2;
 }
 
@@ -194,6 +229,7 @@ int main(int argc, char **argv)
     std::string program = self_dir() + "/gravscale", models_dir, model_arg = "lite", res_arg = "both",
                 cpus_arg = "both", prefetch_arg = "both", threads_arg = "auto";
     int n_frames = 540, repeat = 1;
+    double idle_wait_s = 0;
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         auto val = [&](std::string &out) {
@@ -209,6 +245,10 @@ int main(int argc, char **argv)
         else if (a == "--cpus") { if (!val(cpus_arg)) return usage(); }
         else if (a == "--prefetch") { if (!val(prefetch_arg)) return usage(); }
         else if (a == "--threads") { if (!val(threads_arg)) return usage(); }
+        else if (a == "--wait-idle") {
+            if (!val(v)) return usage();
+            idle_wait_s = std::atof(v.c_str());
+        }
         else if (a == "--frames" || a == "--repeat") {
             if (!val(v)) return usage();
             int n = std::atoi(v.c_str());
@@ -268,7 +308,7 @@ int main(int argc, char **argv)
     std::printf("clip %s: %zu frames %dx%d, played forwards and backwards to %d frames; program %s\n", clip.c_str(),
                 frames.size(), frames[0].cols, frames[0].rows, n_frames, program.c_str());
     std::printf("%-5s %9s %4s %3s %3s | %6s %6s %7s | %6s %6s %6s %6s %6s | %5s | %-11s %s\n", "model", "frame", "cpus",
-                "thr", "pre", "fps", "e2e", "cpu ms", "decode", "pose", "net", "scene", "core", "net%", "load", "output");
+                "thr", "pre", "fps", "e2e", "cpu ms", "decode", "pose", "net", "scene", "core", "net%", "load  others", "output");
     int rc = 0;
     for (int h : heights) {
         double scale = static_cast<double>(h) / std::min(frames[0].cols, frames[0].rows);
@@ -293,6 +333,7 @@ int main(int argc, char **argv)
                     RunResult best;
                     double best_fps = -1;
                     for (int k = 0; k < repeat; k++) {
+                        if (idle_wait_s > 0) wait_idle(idle_wait_s);
                         RunResult r = run_once(program, args, c, dir);
                         if (!r.ok) {
                             rc = 1;
@@ -315,10 +356,10 @@ int main(int argc, char **argv)
                     char res[32];
                     std::snprintf(res, sizeof res, "%dx%d", static_cast<int>(std::lround(frames[0].cols * scale)),
                                   static_cast<int>(std::lround(frames[0].rows * scale)));
-                    std::printf("%-5s %9s %4d %3d %3d | %6.1f %6.1f %7.1f | %6.2f %6.1f %6.1f %6.1f %6.2f | %4.0f%% | %4.2f %4.2f  %s\n",
+                    std::printf("%-5s %9s %4d %3d %3d | %6.1f %6.1f %7.1f | %6.2f %6.1f %6.1f %6.1f %6.2f | %4.0f%% | %4.2f %4.2f %4.2f  %s\n",
                                 m.c_str(), res, c, static_cast<int>(jnum(t, "cv_threads")), pf, n / loop, n / best.wall_s,
                                 1e3 * best.cpu_s / n, jnum(t, "decode_ms"), jnum(t, "pose_ms"), net, jnum(t, "scene_ms"),
-                                jnum(t, "core_ms"), 100.0 * net * n / (1e3 * loop), best.load_before, best.load_after, same);
+                                jnum(t, "core_ms"), 100.0 * net * n / (1e3 * loop), best.load_before, best.load_after, best.others, same);
                     std::fflush(stdout);
                 }
             }
