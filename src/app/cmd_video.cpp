@@ -534,7 +534,11 @@ struct PersonFront {
 };
 
 // GS_VIDEO_TIMES=FILE: where the frame loop's time went, one JSON line
-// appended to FILE (for tools/bench_pipeline; not part of the output)
+// appended to FILE (for tools/bench_pipeline; not part of the output): per
+// frame, the wall ms spent in each stage and the CPU ms of the thread that ran
+// it (OpenCV's and FFmpeg's helper threads not counted; the network's time
+// is the pose tracker's own det_ms + lm_ms, wall only); the process's CPU
+// time of the setup and of the loop.
 struct LoopTimes {
     gs::StageClock decode, pose, network, scene, core, wait;
     double t0_ms = 0.0, loop0_ms = 0.0, cpu0_ms = 0.0, loop_cpu0_ms = 0.0;
@@ -544,9 +548,9 @@ struct LoopTimes {
     {
         FILE *f = std::fopen(path, "a");
         if (!f) return;
-        auto per = [&](const gs::StageClock &c, const char *name) {
-            std::fprintf(f, ",\"%s_ms\":%.3f,\"%s_cpu_ms\":%.3f", name, frames ? c.wall_ms / frames : 0.0, name,
-                         frames ? c.cpu_ms / frames : 0.0);
+        auto per = [&](const gs::StageClock &c, const char *name) {  // the network's clock is wall time only
+            std::fprintf(f, ",\"%s_ms\":%.3f", name, frames ? c.wall_ms / frames : 0.0);
+            if (&c != &network) std::fprintf(f, ",\"%s_cpu_ms\":%.3f", name, frames ? c.cpu_ms / frames : 0.0);
         };
         std::fprintf(f, "{\"frames\":%lld,\"prefetch\":%d,\"cv_threads\":%d,\"setup_s\":%.4f,\"loop_s\":%.4f,"
                         "\"total_s\":%.4f,\"setup_cpu_s\":%.4f,\"loop_cpu_s\":%.4f,\"detector_runs\":%lld",
