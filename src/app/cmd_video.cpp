@@ -19,7 +19,9 @@
 #include "frame_source.hpp"
 #include "overlay.hpp"
 #include "pose_blazepose.hpp"
+#include "prefetch.hpp"
 #include "scene_watch.hpp"
+#include "stage_clock.hpp"
 
 #if __has_include("ball_detector.hpp")
 #include "ball_detector.hpp"
@@ -59,6 +61,9 @@ const char kHelp[] =
     "  --models DIR         folder of the converted pose networks (default: models/\n"
     "                       of the source tree, made by tools/fetch_models.sh)\n"
     "  --threads N          OpenCV threads for the pose networks (default: OpenCV's)\n"
+    "  --prefetch N         pose: decode and run the networks up to N frames ahead\n"
+    "                       of the rest, in two more threads (default 2; 0: all in\n"
+    "                       one thread); the output is the same\n"
     "  --stabilize on|off   pose: map keypoints into the first frame's view using the\n"
     "                       background's motion (default on; flights still carry\n"
     "                       camera_moved when the camera moved)\n"
@@ -88,6 +93,7 @@ struct Options {
     std::string input, config, trace, overlay, plot, detector = "ball";
     std::string model, models;
     int threads = -1;              // -1: from the config
+    int prefetch = 2;              // pose: frames decoded and posed ahead (0: one thread)
     bool stabilize = true;
     double fps = 0.0;
     bool out_format_set = false;
@@ -105,7 +111,7 @@ int parse_args(int argc, char **argv, Options &o)
 {
     static const char *const known[] = {"--detector", "--fps",     "--config", "--output-format", "--trace",
                                         "--overlay",  "--plot",    "--model",  "--models",        "--threads",
-                                        "--stabilize"};
+                                        "--stabilize", "--prefetch"};
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
@@ -142,6 +148,11 @@ int parse_args(int argc, char **argv, Options &o)
             if (!gs_num_parse(val.c_str(), val.size(), &t) || t != std::floor(t) || t < 0 || t > 64)
                 return usage_error("--threads must be a whole number 0..64, not '" + val + "'");
             o.threads = static_cast<int>(t);
+        } else if (name == "--prefetch") {
+            double t;
+            if (!gs_num_parse(val.c_str(), val.size(), &t) || t != std::floor(t) || t < 0 || t > 64)
+                return usage_error("--prefetch must be a whole number 0..64, not '" + val + "'");
+            o.prefetch = static_cast<int>(t);
         } else if (name == "--stabilize") {
             if (val != "on" && val != "off") return usage_error("--stabilize must be on or off, not '" + val + "'");
             o.stabilize = val == "on";
@@ -469,10 +480,10 @@ struct PersonFront {
     bool stabilize = true;
     explicit PersonFront(const gs::PoseConfig &pc) : pose(pc) {}
 
-    // one frame -> keypoints for the core (c = 0 when no body); records the scene facts
-    void frame(const cv::Mat &bgr, double t_s, gs_kp *kp, gs::SceneFrame *sf, gs::PoseOutput *po)
+    // one frame and its pose (pose.process, maybe run ahead in another thread) ->
+    // keypoints for the core (c = 0 when no body); records the scene facts
+    void frame(const cv::Mat &bgr, double t_s, gs_kp *kp, gs::SceneFrame *sf, const gs::PoseOutput *po)
     {
-        pose.process(bgr, t_s, po);
         std::vector<cv::Rect> ex;
         float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
         if (po->present) {
@@ -522,8 +533,48 @@ struct PersonFront {
     }
 };
 
+// GS_VIDEO_TIMES=FILE: where the frame loop's time went, one JSON line
+// appended to FILE (for tools/bench_pipeline; not part of the output): per
+// frame, the wall ms spent in each stage and the CPU ms of the thread that ran
+// it (OpenCV's and FFmpeg's helper threads not counted; the network's time
+// is the pose tracker's own det_ms + lm_ms, wall only); the process's CPU
+// time of the setup and of the loop.
+struct LoopTimes {
+    gs::StageClock decode, pose, network, scene, core, wait;
+    double t0_ms = 0.0, loop0_ms = 0.0, cpu0_ms = 0.0, loop_cpu0_ms = 0.0;
+    int64_t frames = 0, detector_runs = 0;
+
+    void write(const char *path, int prefetch, double end_ms, double end_cpu_ms) const
+    {
+        FILE *f = std::fopen(path, "a");
+        if (!f) return;
+        auto per = [&](const gs::StageClock &c, const char *name) {  // the network's clock is wall time only
+            std::fprintf(f, ",\"%s_ms\":%.3f", name, frames ? c.wall_ms / frames : 0.0);
+            if (&c != &network) std::fprintf(f, ",\"%s_cpu_ms\":%.3f", name, frames ? c.cpu_ms / frames : 0.0);
+        };
+        std::fprintf(f, "{\"frames\":%lld,\"prefetch\":%d,\"cv_threads\":%d,\"setup_s\":%.4f,\"loop_s\":%.4f,"
+                        "\"total_s\":%.4f,\"setup_cpu_s\":%.4f,\"loop_cpu_s\":%.4f,\"detector_runs\":%lld",
+                     static_cast<long long>(frames), prefetch, cv::getNumThreads(), (loop0_ms - t0_ms) / 1e3,
+                     (end_ms - loop0_ms) / 1e3, (end_ms - t0_ms) / 1e3, (loop_cpu0_ms - cpu0_ms) / 1e3,
+                     (end_cpu_ms - loop_cpu0_ms) / 1e3, static_cast<long long>(detector_runs));
+        per(decode, "decode");
+        per(pose, "pose");
+        per(network, "network");
+        per(scene, "scene");
+        per(core, "core");
+        per(wait, "wait");
+        std::fputs("}\n", f);
+        std::fclose(f);
+    }
+};
+
 int run(const Options &o)
 {
+    LoopTimes times;
+    times.t0_ms = gs::wall_ms_now();
+    times.cpu0_ms = gs::process_cpu_ms_now();
+    const char *times_path = std::getenv("GS_VIDEO_TIMES");
+    if (times_path && !*times_path) times_path = nullptr;
     const bool person = o.detector == "pose";
     gs_core_config cfg;
     gs::BallConfig ball_cfg;
@@ -601,16 +652,63 @@ int run(const Options &o)
     const bool progress = isatty(STDERR_FILENO) != 0;
     double next_progress = now_s() + 0.25;
     bool shown = false;
-    while (!app.out.err && src->next(f)) {
+    // the frames, and for a person their pose: in this thread, or (--prefetch N)
+    // decoded in one thread and posed in another, up to N frames ahead; each
+    // stage still takes the frames one by one in order, so the output is the same
+    struct Posed {
+        gs::Frame f;
+        gs::PoseOutput po;
+    };
+    auto decode = [&](gs::Frame &fr) {
+        gs::StageClock::Scope s(times.decode);
+        return src->next(fr);
+    };
+    auto pose = [&](const gs::Frame &fr, gs::PoseOutput &po) {
+        {
+            gs::StageClock::Scope s(times.pose);
+            front->pose.process(fr.bgr, fr.t_s, &po);
+        }
+        times.network.wall_ms += po.det_ms + po.lm_ms;
+        times.detector_runs += po.detector_ran;
+    };
+    std::unique_ptr<gs::Prefetch<gs::Frame>> decoded;
+    std::unique_ptr<gs::Prefetch<Posed>> posed;
+    if (person && o.prefetch > 0) {
+        const size_t depth = static_cast<size_t>(o.prefetch);
+        decoded.reset(new gs::Prefetch<gs::Frame>(decode, depth));
+        posed.reset(new gs::Prefetch<Posed>(
+            [&](Posed &p) {
+                if (!decoded->next(p.f)) return false;
+                pose(p.f, p.po);
+                return true;
+            },
+            depth));
+    }
+    gs::PoseOutput po;
+    auto next_frame = [&]() {
+        if (!posed) return decode(f) && (!person || (pose(f, po), true));
+        gs::StageClock::Scope s(times.wait);  // the time this thread waits for the workers
+        Posed p;
+        if (!posed->next(p)) return false;
+        f = std::move(p.f);
+        po = p.po;
+        return true;
+    };
+    times.loop0_ms = gs::wall_ms_now();
+    times.loop_cpu0_ms = gs::process_cpu_ms_now();
+    while (!app.out.err && next_frame()) {
+        times.frames++;
         if (f.bgr.size() != app.rec.frame_size) app.rec.frame_size = f.bgr.size();
         app.rec.frame_t.push_back(f.t_s);
         app.rec.frame_obs.emplace_back();
         if (person) {
             gs_kp kp[gs::kPoseKeypoints];
             gs::SceneFrame sf;
-            gs::PoseOutput po;
-            front->frame(f.bgr, f.t_s, kp, &sf, &po);
-            front->watch.add(sf);
+            {
+                gs::StageClock::Scope s(times.scene);
+                front->frame(f.bgr, f.t_s, kp, &sf, &po);
+                front->watch.add(sf);
+            }
             if (keep) {
                 app.rec.frame_kp.emplace_back();
                 if (po.present) {
@@ -628,6 +726,7 @@ int run(const Options &o)
                 std::fprintf(stderr, "gravscale: cannot start the pipeline: %s\n", gs_status_str(pipes.init_error()));
                 return EXIT_USAGE;
             }
+            gs::StageClock::Scope core_clock(times.core);
             gs_status st = gs_pipeline_push_keypoints(p, f.t_s, kp);
             if (st != GS_OK && pipes.refused++ == 0) pipes.first_refusal = st;
             uint32_t on = front->watch.onsets();
@@ -667,6 +766,8 @@ int run(const Options &o)
         }
     }
     if (shown) std::fputs("\r                                        \r", stderr);
+    posed.reset();  // the workers are done (or stopped: output error)
+    decoded.reset();
     if (app.out.err) return output_status(app);
     if (!src->error().empty()) {
         // an image that cannot be decoded: bad input, no summary (as replay)
@@ -698,6 +799,7 @@ int run(const Options &o)
     }
     app.trace_on = false;
     gs_out_close(&app.out);
+    if (times_path) times.write(times_path, person ? o.prefetch : 0, gs::wall_ms_now(), gs::process_cpu_ms_now());
     if (rc != EXIT_OK) return rc;
 
     if (keep) gs::fit_jump_curves(app.rec);

@@ -67,12 +67,19 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
                               (int)(r.height * scale_) + 2 * m));
     }
 
+    // the pyramid of this frame, built once: it is the next frame's previous one
+    // (calcOpticalFlowPyrLK given the images builds the same pyramids, both each time)
+    const cv::Size win(21, 21);
+    const int levels = 3;
+    std::vector<cv::Mat> pyr;
+    cv::buildOpticalFlowPyramid(cur, pyr, win, levels, false);
+
     bool matched = false;
     if (have_ && !pts_.empty()) {
         std::vector<cv::Point2f> next;
         std::vector<uchar> st;
         std::vector<float> err;
-        cv::calcOpticalFlowPyrLK(prev_, cur, pts_, next, st, err, cv::Size(21, 21), 3);
+        cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, pts_, next, st, err, win, levels);
         std::vector<cv::Point2f> a, b;
         for (size_t i = 0; i < pts_.size(); i++)
             if (st[i] && !inside_any(ex, next[i]) && !inside_any(ex, pts_[i])) {
@@ -134,7 +141,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
                 for (cv::Point2f &p : fresh) pts_.push_back(p + cv::Point2f((float)cell.x, (float)cell.y));
             }
     }
-    prev_ = cur;
+    prev_pyr_.swap(pyr);
     have_ = true;
 }
 

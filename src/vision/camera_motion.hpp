@@ -40,7 +40,7 @@ public:
 private:
     CameraMotionConfig cfg_;
     double scale_ = 1.0;           // working / full
-    cv::Mat prev_;                 // previous working grey frame
+    std::vector<cv::Mat> prev_pyr_; // previous working grey frame's Lucas-Kanade pyramid
     std::vector<cv::Point2f> pts_; // corners in prev_
     cv::Matx23d cur_from_ref_;     // full-frame pixels: reference -> current
     bool have_ = false;

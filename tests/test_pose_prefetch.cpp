@@ -1,0 +1,186 @@
+// test_pose_prefetch.cpp - the prefetching frame loop of `gravscale video
+// --detector pose` (decode and pose networks in their own threads, --prefetch
+// N) gives exactly the output of the sequential loop (--prefetch 0), byte for
+// byte, events and trace, on real clips: the gym jump (tracked throughout) and
+// people walking (the detector runs again and again). And gs::Prefetch itself:
+// order, the end, an exception from the worker, stopping early.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <vector>
+
+extern "C" {
+#include "unity.h"
+}
+
+#include "pose_blazepose.hpp"
+#include "prefetch.hpp"
+
+#ifndef GS_SHARED_DIR
+#error "GS_SHARED_DIR must be defined"
+#endif
+
+void setUp(void) {}
+void tearDown(void) {}
+
+namespace {
+
+bool exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+std::string read_all(const std::string &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+struct Run {
+    int code = -1;
+    std::string out, trace;
+};
+
+Run run(const std::string &clip, const std::string &args)
+{
+    const std::string trace = "/tmp/gs_test_pose_prefetch.trace.jsonl";
+    std::remove(trace.c_str());
+    std::string cmd = std::string(GS_PROGRAM) + " video '" + clip + "' --detector pose --trace " + trace + " " + args +
+                      " 2>/tmp/gs_test_pose_prefetch.err";
+    Run r;
+    FILE *p = popen(cmd.c_str(), "r");
+    TEST_ASSERT_NOT_NULL(p);
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+    int st = pclose(p);
+    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+    r.trace = read_all(trace);
+    std::remove(trace.c_str());
+    return r;
+}
+
+int count_of(const std::string &s, const std::string &pat)
+{
+    int n = 0;
+    for (size_t p = s.find(pat); p != std::string::npos; p = s.find(pat, p + 1)) n++;
+    return n;
+}
+
+// false (and the test ignored) when the clip or the networks are absent
+bool have(const char *clip_rel, char *clip, size_t cap)
+{
+    std::snprintf(clip, cap, "%s/%s", GS_SHARED_DIR, clip_rel);
+    std::string err;
+    return exists(clip) && gs::pose_models_present(gs::PoseConfig(), err);
+}
+
+void same_output(const std::string &clip, const std::string &extra, const std::vector<int> &depths)
+{
+    Run seq = run(clip, "--prefetch 0 " + extra);
+    TEST_ASSERT_EQUAL_INT(0, seq.code);
+    TEST_ASSERT_TRUE(count_of(seq.out, "\"event\":\"summary\"") >= 1);
+    TEST_ASSERT_TRUE(count_of(seq.trace, "\"event\":\"sample\"") > 10);
+    for (int d : depths) {
+        Run pre = run(clip, "--prefetch " + std::to_string(d) + " " + extra);
+        TEST_ASSERT_EQUAL_INT(0, pre.code);
+        TEST_ASSERT_TRUE_MESSAGE(pre.out == seq.out, ("events differ with --prefetch " + std::to_string(d)).c_str());
+        TEST_ASSERT_TRUE_MESSAGE(pre.trace == seq.trace, ("trace differs with --prefetch " + std::to_string(d)).c_str());
+    }
+    std::printf("%s %s: %zu bytes of events, %zu of trace, the same with --prefetch 0 and", clip.c_str(),
+                extra.c_str(), seq.out.size(), seq.trace.size());
+    for (int d : depths) std::printf(" %d", d);
+    std::printf("\n");
+}
+
+}  // namespace
+
+static void test_prefetch_order_end_and_errors(void)
+{
+    for (size_t depth : {1u, 3u, 64u}) {
+        int i = 0;
+        gs::Prefetch<int> q([&](int &v) { return (v = i++) < 1000; }, depth);
+        int v = -1, n = 0;
+        while (q.next(v)) TEST_ASSERT_EQUAL_INT(n++, v);
+        TEST_ASSERT_EQUAL_INT(1000, n);
+        TEST_ASSERT_FALSE(q.next(v));  // stays at the end
+    }
+    {  // an exception in the worker: the items before it, then the exception
+        int i = 0;
+        gs::Prefetch<int> q(
+            [&](int &v) {
+                if (i == 5) throw std::runtime_error("boom");
+                v = i++;
+                return true;
+            },
+            2);
+        int v = -1, n = 0;
+        bool thrown = false;
+        try {
+            while (q.next(v)) TEST_ASSERT_EQUAL_INT(n++, v);
+        } catch (const std::runtime_error &e) {
+            thrown = std::strcmp(e.what(), "boom") == 0;
+        }
+        TEST_ASSERT_TRUE(thrown);
+        TEST_ASSERT_EQUAL_INT(5, n);
+    }
+    {  // stopped early: the destructor joins a worker waiting on a full queue
+        int i = 0;
+        gs::Prefetch<int> q([&](int &v) { return (v = i++), true; }, 2);
+        int v = -1;
+        TEST_ASSERT_TRUE(q.next(v));
+        TEST_ASSERT_EQUAL_INT(0, v);
+    }
+    {  // a chain, as the frame loop: stage 2 pulls from stage 1 in its worker
+        int i = 0;
+        gs::Prefetch<int> a([&](int &v) { return (v = i++) < 300; }, 2);
+        gs::Prefetch<long> b(
+            [&](long &w) {
+                int v;
+                if (!a.next(v)) return false;
+                w = 3L * v;
+                return true;
+            },
+            2);
+        long w = -1, n = 0;
+        while (b.next(w)) TEST_ASSERT_EQUAL_INT64(3 * n++, w);
+        TEST_ASSERT_EQUAL_INT64(300, n);
+    }
+}
+
+static void test_gym_jump_same_output_with_prefetch(void)
+{
+    // a plain buffer: TEST_IGNORE longjmps out of the test, past C++ destructors
+    char clip[512];
+    if (!have("data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", clip, sizeof clip))
+        TEST_IGNORE_MESSAGE("jumpvision_jumps or the pose networks are absent");
+    same_output(clip, "--model lite", {1, 2});
+    same_output(clip, "--model lite --threads 2", {2});
+    same_output(clip, "--model full --threads 1", {2});
+}
+
+static void test_people_walking_same_output_with_prefetch(void)
+{
+    char clip[512];
+    if (!have("data/real/opencv_vtest/vtest_first15s_h264.mp4", clip, sizeof clip))
+        TEST_IGNORE_MESSAGE("opencv_vtest or the pose networks are absent");
+    same_output(clip, "--model lite", {2});
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_prefetch_order_end_and_errors);
+    RUN_TEST(test_gym_jump_same_output_with_prefetch);
+    RUN_TEST(test_people_walking_same_output_with_prefetch);
+    return UNITY_END();
+}
