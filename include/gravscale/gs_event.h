@@ -36,6 +36,7 @@ typedef enum {
 #define GS_WARN_CAMERA_MOVED  0x20u /* "camera_moved": the background moved during the flight (not a static camera) */
 #define GS_WARN_LEFT_FRAME    0x40u /* "left_frame": the body touched the frame's border during the flight */
 #define GS_WARN_OUT_OF_PLANE  0x80u /* "out_of_plane": the body moved toward or away from the camera */
+#define GS_WARN_OTHER_MOTION  0x100u /* "other_motion": something else moved right beside the body during the flight */
 
 const char *gs_reject_reason_name(gs_reject_reason r);
 

@@ -37,6 +37,7 @@ uint32_t SceneWatch::flight_warnings(double t0, double t1, double t_apex) const
     uint32_t w = 0;
     bool first = true;
     double x0 = 0, y0 = 0, moved = 0;
+    int other = 0;
     std::vector<double> sizes, before, after;
     for (const SceneFrame &f : frames_) {
         if (f.t_s >= t0 - 0.4 && f.t_s < t0 - 0.05 && std::isfinite(f.ground_y_px)) before.push_back(f.ground_y_px);
@@ -44,6 +45,7 @@ uint32_t SceneWatch::flight_warnings(double t0, double t1, double t_apex) const
         if (f.t_s < a || f.t_s > b) continue;
         if (std::isfinite(f.size_px)) sizes.push_back(f.size_px);
         if (f.present && f.at_border) w |= GS_WARN_LEFT_FRAME;
+        if (f.other >= cfg_.other_corners) other++;
         if (!f.cam_valid) {
             w |= GS_WARN_CAMERA_MOVED;  // unknown camera motion is no static camera either
             continue;
@@ -58,6 +60,8 @@ uint32_t SceneWatch::flight_warnings(double t0, double t1, double t_apex) const
     double size = median(sizes);
     double thr = std::max(cfg_.cam_moved_min_px, std::isfinite(size) ? cfg_.cam_moved_rel * size : 0.0);
     if (moved > thr) w |= GS_WARN_CAMERA_MOVED;
+    // someone (something) moved right beside the body: its keypoints may have followed
+    if (other >= cfg_.other_frames) w |= GS_WARN_OTHER_MOTION;
     // the feet land on another row: the body moved in depth (or the camera tilted)
     double gb = median(before), ga = median(after);
     if (std::isfinite(gb) && std::isfinite(ga) && std::isfinite(size) && std::fabs(ga - gb) > cfg_.depth_rel * size)
