@@ -492,7 +492,6 @@ struct PersonFront {
         sf->cam_dx_px = cm.dx_px;
         sf->cam_dy_px = cm.dy_px;
         sf->other = cm.other;
-        if (std::getenv("GS_TRACE_OTHER")) std::fprintf(stderr, "other t %.3f %d inl %d\n", t_s, cm.other, cm.inliers);
         sf->present = po->present;
         sf->ground_y_px = NAN;
         sf->size_px = NAN;
