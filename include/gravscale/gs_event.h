@@ -23,7 +23,8 @@ typedef enum {
     GS_REJ_IMPLAUSIBLE_A,   /* "implausible_acceleration" */
     GS_REJ_NO_SIZE,         /* "no_size": no standing pixel size known around the flight */
     GS_REJ_UNCERTAIN_A,     /* "uncertain_acceleration": relative SE of a too large */
-    GS_REJ_GAP              /* "gap": frames missing inside the flight */
+    GS_REJ_GAP,             /* "gap": frames missing inside the flight */
+    GS_REJ_OTHER_MOTION     /* "other_motion": from the front end: something else moved beside the body through much of the flight */
 } gs_reject_reason;
 
 /* warning bits of a jump */

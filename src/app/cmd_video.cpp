@@ -357,6 +357,18 @@ void on_event(void *ctx, const gs_event *ev)
         a.emit_fail++;
 }
 
+// The frames' say on a flight before the core reports and aggregates it: something
+// else moving right beside the person through much of the flight rejects it.
+void judge_jump(void *ctx, gs_ev_jump *j)
+{
+    App &a = *static_cast<App *>(ctx);
+    if (!a.watch || !j->accepted) return;
+    if (a.watch->other_rejects(j->t_takeoff_s, j->t_land_s, j->t_apex_s)) {
+        j->accepted = false;
+        j->reason = GS_REJ_OTHER_MOTION;
+    }
+}
+
 // One core pipeline per tracked ball.
 struct TrackPipe {
     gs_pipeline p;
@@ -381,6 +393,7 @@ public:
             }
             gs_pipeline_set_track(&tp->p, static_cast<uint32_t>(pipes_.size()));
             gs_pipeline_set_trace(&tp->p, app_.trace_on);
+            gs_pipeline_set_judge(&tp->p, judge_jump, &app_);
             pipes_.push_back(std::move(tp));
         }
         return &pipes_[track]->p;

@@ -32,6 +32,7 @@ struct SceneWatchConfig {
     double margin_s = 0.1;         // the window reaches this far beyond take-off and landing
     int other_corners = 6;         // a frame with this many corners moving beside the body sees other motion
     int other_frames = 3;          // ... in this many frames of the window: GS_WARN_OTHER_MOTION
+    double other_reject = 0.25;    // ... in this share of the window's frames (and other_frames): reject
 };
 
 class SceneWatch {
@@ -45,6 +46,10 @@ public:
     // at sub-frame precision by the two nearest airborne frames under the flight's
     // acceleration a_px_s2. false when the feet do not show it clearly.
     bool feet_flight(double t_takeoff_s, double t_land_s, double a_px_s2, double *t0_s, double *t1_s) const;
+    // frames of the flight's window that saw other motion beside the body, and all its frames
+    int other_motion(double t_takeoff_s, double t_land_s, double t_apex_s, int *frames) const;
+    // the flight is not to be trusted: other motion through other_reject of its window
+    bool other_rejects(double t_takeoff_s, double t_land_s, double t_apex_s) const;
     // bits of conditions that started with the newest frame (each reported once per onset)
     uint32_t onsets();
 
