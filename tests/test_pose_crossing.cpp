@@ -345,6 +345,7 @@ struct Jump {
     double ft = NAN, q = NAN, h = NAN;
     bool accepted = false, camera_moved = false;
     int sessions = 0;
+    std::string reason, warnings;
     std::string out;
 };
 Jump jump_of(const std::string &clip, const char *config)
@@ -366,13 +367,18 @@ Jump jump_of(const std::string &clip, const char *config)
         j.h = num(jumps[0], "height_m");
         j.accepted = jumps[0].find("\"accepted\":true") != std::string::npos;
         j.camera_moved = jumps[0].find("\"camera_moved\"") != std::string::npos;
+        size_t rr = jumps[0].find("\"reason\":\"");
+        if (rr != std::string::npos) j.reason = jumps[0].substr(rr + 10, jumps[0].find('"', rr + 10) - rr - 10);
+        size_t w = jumps[0].find("\"warnings\":[");
+        if (w != std::string::npos) j.warnings = jumps[0].substr(w + 12, jumps[0].find(']', w) - w - 12);
     }
     return j;
 }
 void print_jump(const char *tag, const Jump &j)
 {
-    std::printf("%s: %d flight(s), flight %.4f s, q %.6g m/px, height %.4f m, accepted %d, %d session events\n", tag,
-                j.n, j.ft, j.q, j.h, j.accepted, j.sessions);
+    std::printf("%s: %d flight(s), flight %.4f s, q %.6g m/px, height %.4f m, accepted %d%s%s, %d session events, "
+                "warnings [%s]\n", tag, j.n, j.ft, j.q, j.h, j.accepted, j.reason.empty() ? "" : " ", j.reason.c_str(),
+                j.sessions, j.warnings.c_str());
 }
 std::string g_off_cfg;  // [pose] keep_person = off: the ROI alone, as before the keeper
 std::string g_cross_b;
