@@ -153,9 +153,21 @@ int CameraMotion::other_motion(const cv::Mat &cur, const std::vector<cv::Rect> &
         mask(cv::Rect(r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g) & all).setTo(255);
     }
     for (const cv::Rect &r : ex) mask(r & all).setTo(0);
+    // the corners are found at half the working size (a quarter of the cost; the
+    // Lucas-Kanade pass below works at the full working size)
+    cv::Rect box = cv::boundingRect(mask);
+    box.x &= ~1;
+    box.y &= ~1;
+    box.width = std::min(prev_.cols - box.x, (box.width + 3) & ~1);
+    box.height = std::min(prev_.rows - box.y, (box.height + 3) & ~1);
+    if (box.width < 8 || box.height < 8) return 0;
+    cv::Mat half, half_mask;
+    cv::resize(prev_(box), half, cv::Size(box.width / 2, box.height / 2), 0, 0, cv::INTER_AREA);
+    cv::resize(mask(box), half_mask, half.size(), 0, 0, cv::INTER_NEAREST);
     std::vector<cv::Point2f> p0, p1;
-    cv::goodFeaturesToTrack(prev_, p0, cfg_.ring_features, 0.01, 0.5 * cfg_.min_spacing_px, mask, 5);
+    cv::goodFeaturesToTrack(half, p0, cfg_.ring_features, 0.01, 0.25 * cfg_.min_spacing_px, half_mask, 3);
     if (p0.empty()) return 0;
+    for (cv::Point2f &p : p0) p = cv::Point2f(2.0f * p.x + 0.5f + (float)box.x, 2.0f * p.y + 0.5f + (float)box.y);
     std::vector<uchar> st;
     std::vector<float> err;
     cv::calcOpticalFlowPyrLK(prev_, cur, p0, p1, st, err, cv::Size(21, 21), 3);
