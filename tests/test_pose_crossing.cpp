@@ -503,7 +503,8 @@ static void test_sweep_keeps_the_promise(void)
 {
     // Every crossing: no accepted height off the clean run's by more than 2 %, no
     // extra flight, one visit (no session split); a flight the walker overlaps
-    // that is accepted carries a warning.
+    // carries other_motion, accepted or not. Before the other-motion cue this
+    // failed on "behind" only: 1.650 m accepted without a warning (clean 1.702 m).
     if (g_sweep.empty() || !std::isfinite(g_clean_jump.h)) TEST_IGNORE_MESSAGE("no clean run");
     int bad = 0;
     std::string why;
@@ -525,6 +526,7 @@ static void test_sweep_keeps_the_promise(void)
         if (j.accepted && std::fabs(j.h - g_clean_jump.h) > 0.02 * g_clean_jump.h && !warned) e += " wrong height accepted without a warning;";
         if (j.accepted && std::fabs(j.h - g_clean_jump.h) > 0.02 * g_clean_jump.h && warned) e += " wrong height accepted (warned);";
         if (j.accepted && ov > 0 && !warned) e += " overlapped flight accepted without a warning;";
+        if (!j.accepted && ov > 0 && !warned) e += " overlapped flight without other_motion;";
         if (!e.empty()) {
             bad++;
             why += std::string(v.name) + ":" + e + " ";
