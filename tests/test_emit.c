@@ -298,7 +298,7 @@ void test_json_exact_lines(void)
                     "\"warnings\":[]}\n");
     e.u.jump.accepted = false;
     e.u.jump.reason = GS_REJ_UNCERTAIN_A;
-    e.u.jump.warnings = GS_WARN_FEW_SAMPLES | GS_WARN_OUTLIERS | GS_WARN_CLIPPED | 0x100u; /* unknown bit */
+    e.u.jump.warnings = GS_WARN_FEW_SAMPLES | GS_WARN_OUTLIERS | GS_WARN_CLIPPED | 0x200u; /* unknown bit */
     e.u.jump.height_m = NAN;
     e.u.jump.height_se_m = INFINITY;
     e.u.jump.q_m_per_px = 1.5e-05;
@@ -311,13 +311,13 @@ void test_json_exact_lines(void)
                     "\"n_samples\":14,\"n_outliers\":1,\"rms_px\":0.877,\"accepted\":false,"
                     "\"reason\":\"uncertain_acceleration\",\"warnings\":[\"few_samples\",\"outliers\","
                     "\"edge_truncated\"]}\n");
-    e.u.jump.warnings = 0xFFu;
+    e.u.jump.warnings = 0x1FFu;
     e.u.jump.reason = GS_REJ_GAP;
     char buf[GS_EMIT_MAX];
     gs_emit_json(&e, buf, sizeof buf);
     TEST_ASSERT_NOT_NULL(strstr(buf, "\"reason\":\"gap\",\"warnings\":[\"few_samples\",\"gravity_tilt\","
                                      "\"size_changed\",\"outliers\",\"edge_truncated\",\"camera_moved\","
-                                     "\"left_frame\",\"out_of_plane\"]}\n"));
+                                     "\"left_frame\",\"out_of_plane\",\"other_motion\"]}\n"));
 
     memset(&e, 0, sizeof e);
     e.type = GS_EV_HEIGHT;

@@ -123,6 +123,7 @@ typedef struct {
 
 static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(double) + 8];
 
+static gs_jump_judge_fn g_judge; /* the front end's judge for run_from (NULL: none) */
 static void run_from(const sim_track *s, const cam *c, capture *cap, double t_begin, double t_end);
 static void run(const sim_track *s, const cam *c, capture *cap, double t_end) { run_from(s, c, cap, 0.0, t_end); }
 
@@ -135,6 +136,7 @@ static void run_from(const sim_track *s, const cam *c, capture *cap, double t_be
     static gs_pipeline p;
     memset(cap, 0, sizeof *cap);
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, cap));
+    gs_pipeline_set_judge(&p, g_judge, cap);
     double ca = cos(c->roll_deg * PI / 180.0), sa = sin(c->roll_deg * PI / 180.0);
     double size_px = c->size_m / c->q_m_per_px;
     for (long i = (long)ceil(t_begin * c->fps);; i++) {
@@ -214,6 +216,37 @@ static void test_exact_track_30fps(void)
     }
     TEST_ASSERT_EQUAL_UINT32(4, cap.summary.n_jumps);
     TEST_ASSERT_DOUBLE_WITHIN(0.001, 0.20, cap.summary.height_m);
+}
+
+/* the front end sees something the keypoints do not in the second flight */
+static void judge_second(void *ctx, gs_ev_jump *j)
+{
+    (void)ctx;
+    if (j->index != 1) return;
+    j->warnings |= GS_WARN_OTHER_MOTION;
+    j->accepted = false;
+    j->reason = GS_REJ_OTHER_MOTION;
+}
+
+/* A judge's rejection is what is reported and what the aggregate counts. */
+static void test_front_end_judge(void)
+{
+    sim_track s;
+    make_track(&s, 4, 1.5, 2.5, 1.4, 2.8);
+    cam c = {30.0, 0.003, 0.0, 0.0, 0.20, 0.0, 0.37};
+    capture cap;
+    g_judge = judge_second;
+    run(&s, &c, &cap, 12.0);
+    g_judge = NULL;
+    TEST_ASSERT_EQUAL_INT(4, cap.n_jumps);
+    TEST_ASSERT_TRUE(cap.jumps[0].accepted);
+    TEST_ASSERT_FALSE(cap.jumps[1].accepted);
+    TEST_ASSERT_EQUAL_INT(GS_REJ_OTHER_MOTION, cap.jumps[1].reason);
+    TEST_ASSERT_EQUAL_UINT32(GS_WARN_OTHER_MOTION, cap.jumps[1].warnings & GS_WARN_OTHER_MOTION);
+    TEST_ASSERT_EQUAL_STRING("other_motion", gs_reject_reason_name(cap.jumps[1].reason));
+    TEST_ASSERT_EQUAL_INT(3, cap.n_height);  /* no running height after the rejected one */
+    TEST_ASSERT_EQUAL_UINT32(3, cap.summary.n_jumps);
+    TEST_ASSERT_EQUAL_UINT32(1, cap.summary.n_rejected);
 }
 
 /* Noisy at 30 fps with outliers and 30 deg roll: every flight found, a within
@@ -452,6 +485,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_exact_track_30fps);
+    RUN_TEST(test_front_end_judge);
     RUN_TEST(test_noisy_rolled);
     RUN_TEST(test_120fps);
     RUN_TEST(test_no_flight);

@@ -13,6 +13,7 @@
 //    B "landing": in front from the descent (~27) to after the landing (~45).
 //  Truth: the jump app's 789 ms flight; the clean FFV1 copy's own run (same
 //  frames, same program) for q and the stature.
+#include <algorithm>
 #include <cmath>
 #include <cmath>
 #include <cstdio>
@@ -60,7 +61,14 @@ struct Walk {
     double x0_px = 2.5;       // centre at the entry frame (A; B: -100)
     double v_px = 17.5;       // per frame: 525 px/s = 1.4 m/s at 2.66 mm/px
     int enter = 3;            // first frame with the walker
+    bool behind = false;      // pasted only outside the jumper's mask (drawn from the clean run's keypoints)
 };
+
+// per frame, the jumper's body drawn from the clean run's keypoints (255 = the jumper)
+std::vector<cv::Mat> g_masks;
+std::vector<std::vector<gs_kp>> g_clean_kp;  // the clean run's keypoints per frame
+int g_man_w = 0;                            // the walker's cut-out width in the photo
+const char *const kOverlapWarning = "\"other_motion\"";
 
 std::string g_dir, g_clean, g_cross;
 char g_gym[512];
@@ -75,6 +83,7 @@ bool exists(const char *p)
 // the walker pasted when w is given.
 bool write_clip(const std::string &out, const Walk *w)
 {
+    if (w && w->behind && g_masks.empty()) return false;
     cv::VideoCapture cap(g_gym);
     if (!cap.isOpened()) return false;
     cv::Mat man, alpha;
@@ -85,6 +94,7 @@ bool write_clip(const std::string &out, const Walk *w)
         std::vector<cv::Point> poly(kMan, kMan + sizeof kMan / sizeof kMan[0]);
         cv::fillPoly(m, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(255));
         cv::Rect bb = cv::boundingRect(poly) & cv::Rect(0, 0, photo.cols, photo.rows);
+        g_man_w = bb.width;
         cv::resize(photo(bb), man, cv::Size(), w->scale, w->scale, cv::INTER_AREA);
         cv::resize(m(bb), alpha, man.size(), 0, 0, cv::INTER_AREA);
         cv::GaussianBlur(alpha, alpha, cv::Size(5, 5), 0);  // a soft edge, as a real cut-out
@@ -104,6 +114,7 @@ bool write_clip(const std::string &out, const Walk *w)
                 for (int x = 0; x < man.cols; x++) {
                     int X = ox + x;
                     if (X < 0 || X >= f.cols) continue;
+                    if (w->behind && (i >= (int)g_masks.size() || g_masks[i].at<uchar>(Y, X))) continue;
                     float a = alpha.at<uchar>(y, x) / 255.0f;
                     if (a <= 0.0f) continue;
                     cv::Vec3b &d = f.at<cv::Vec3b>(Y, X);
@@ -182,6 +193,51 @@ std::vector<cv::Point2d> hips(const std::string &clip, bool keep)
             v.push_back(cv::Point2d(NAN, NAN));
     }
     return v;
+}
+
+// every frame's 33 keypoints (c = 0 when no pose)
+std::vector<std::vector<gs_kp>> keypoints(const std::string &clip)
+{
+    gs::PoseConfig cfg;
+    cfg.threads = 1;
+    gs::PoseTracker t(cfg);
+    std::vector<std::vector<gs_kp>> v;
+    if (!t.ok()) return v;
+    cv::VideoCapture cap(clip);
+    cv::Mat f;
+    gs::PoseOutput o;
+    for (int i = 0; cap.read(f); i++) {
+        t.process(f, i / 30.0, &o);
+        std::vector<gs_kp> k(o.kp, o.kp + gs::kPoseKeypoints);
+        if (!o.present)
+            for (gs_kp &p : k) p.c = 0.0f;
+        v.push_back(k);
+    }
+    return v;
+}
+
+// The jumper's silhouette, drawn generously from keypoints: the trunk's polygon,
+// thick limbs (0.4 of the trunk's length), the head (a disc of 0.5 trunk around
+// the nose), hands and feet, dilated by 15 px. What lies outside is background.
+cv::Mat body_mask(const std::vector<gs_kp> &k, cv::Size size)
+{
+    cv::Mat m(size, CV_8U, cv::Scalar(0));
+    auto P = [&](int i) { return cv::Point((int)std::lround(k[i].x_px), (int)std::lround(k[i].y_px)); };
+    cv::Point2d sh(0.5 * (k[11].x_px + k[12].x_px), 0.5 * (k[11].y_px + k[12].y_px));
+    cv::Point2d hp(0.5 * (k[23].x_px + k[24].x_px), 0.5 * (k[23].y_px + k[24].y_px));
+    double trunk = std::hypot(sh.x - hp.x, sh.y - hp.y);
+    if (!(trunk > 10.0)) return m;
+    std::vector<cv::Point> poly = {P(11), P(12), P(24), P(23)};
+    cv::fillConvexPoly(m, poly, cv::Scalar(255));
+    static const int bones[][2] = {{11, 12}, {11, 23}, {12, 24}, {23, 24}, {11, 13}, {13, 15}, {12, 14},
+                                   {14, 16}, {15, 19}, {16, 20}, {15, 17}, {16, 18}, {23, 25}, {25, 27},
+                                   {24, 26}, {26, 28}, {27, 29}, {29, 31}, {27, 31}, {28, 30}, {30, 32},
+                                   {28, 32}, {0, 11}, {0, 12}};
+    int th = std::max(4, (int)std::lround(0.4 * trunk));
+    for (auto &b : bones) cv::line(m, P(b[0]), P(b[1]), cv::Scalar(255), th);
+    cv::circle(m, P(0), (int)std::lround(0.5 * trunk), cv::Scalar(255), -1);
+    cv::dilate(m, m, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(31, 31)));
+    return m;
 }
 
 gs::PoseBody body(double t, double x, double y, double r)
@@ -289,6 +345,7 @@ struct Jump {
     double ft = NAN, q = NAN, h = NAN;
     bool accepted = false, camera_moved = false;
     int sessions = 0;
+    std::string reason, warnings;
     std::string out;
 };
 Jump jump_of(const std::string &clip, const char *config)
@@ -310,13 +367,18 @@ Jump jump_of(const std::string &clip, const char *config)
         j.h = num(jumps[0], "height_m");
         j.accepted = jumps[0].find("\"accepted\":true") != std::string::npos;
         j.camera_moved = jumps[0].find("\"camera_moved\"") != std::string::npos;
+        size_t rr = jumps[0].find("\"reason\":\"");
+        if (rr != std::string::npos) j.reason = jumps[0].substr(rr + 10, jumps[0].find('"', rr + 10) - rr - 10);
+        size_t w = jumps[0].find("\"warnings\":[");
+        if (w != std::string::npos) j.warnings = jumps[0].substr(w + 12, jumps[0].find(']', w) - w - 12);
     }
     return j;
 }
 void print_jump(const char *tag, const Jump &j)
 {
-    std::printf("%s: %d flight(s), flight %.4f s, q %.6g m/px, height %.4f m, accepted %d, %d session events\n", tag,
-                j.n, j.ft, j.q, j.h, j.accepted, j.sessions);
+    std::printf("%s: %d flight(s), flight %.4f s, q %.6g m/px, height %.4f m, accepted %d%s%s, %d session events, "
+                "warnings [%s]\n", tag, j.n, j.ft, j.q, j.h, j.accepted, j.reason.empty() ? "" : " ", j.reason.c_str(),
+                j.sessions, j.warnings.c_str());
 }
 std::string g_off_cfg;  // [pose] keep_person = off: the ROI alone, as before the keeper
 std::string g_cross_b;
@@ -400,6 +462,79 @@ static void test_landing_crossing_does_not_take_the_track(void)
     TEST_ASSERT_EQUAL_INT(2, j.sessions);
 }
 
+// ---- the sweep: other crossings, each held to the product's promise -------------------
+
+namespace {
+struct Variant {
+    const char *name;
+    Walk w;
+    std::string clip;
+};
+std::vector<Variant> g_sweep;
+
+Walk walk(double scale, double feet_y, double x0, double v, bool behind)
+{
+    Walk w;
+    w.scale = scale;
+    w.feet_y_px = feet_y;
+    w.x0_px = x0;
+    w.v_px = v;
+    w.behind = behind;
+    return w;
+}
+
+// frames where the walker's box meets the jumper's (clean keypoints' box)
+bool overlaps(const Walk &w, int i)
+{
+    if (i < w.enter || i >= (int)g_clean_kp.size()) return false;
+    const std::vector<gs_kp> &k = g_clean_kp[i];
+    float x0 = 1e9f, x1 = -1e9f;
+    for (const gs_kp &p : k) {
+        x0 = std::min(x0, p.x_px);
+        x1 = std::max(x1, p.x_px);
+    }
+    double half = 0.5 * w.scale * g_man_w;
+    double cx = w.x0_px + w.v_px * (i - w.enter);
+    return cx + half > x0 && cx - half < x1;
+}
+}  // namespace
+
+static void test_sweep_keeps_the_promise(void)
+{
+    // Every crossing: no accepted height off the clean run's by more than 2 %, no
+    // extra flight, one visit (no session split); a flight the walker overlaps
+    // carries other_motion, accepted or not. Before the other-motion cue this
+    // failed on "behind" only: 1.650 m accepted without a warning (clean 1.702 m).
+    if (g_sweep.empty() || !std::isfinite(g_clean_jump.h)) TEST_IGNORE_MESSAGE("no clean run");
+    int bad = 0;
+    std::string why;
+    for (const Variant &v : g_sweep) {
+        Jump j = jump_of(v.clip, nullptr);
+        int ov = 0;
+        double t0 = j.n ? num(lines_of(j.out, "jump")[0], "t_takeoff_s") : NAN;
+        double t1 = j.n ? num(lines_of(j.out, "jump")[0], "t_land_s") : NAN;
+        for (int i = 0; i < (int)g_clean_kp.size(); i++)
+            if (i / 30.0 >= t0 - 0.05 && i / 30.0 <= t1 + 0.05 && overlaps(v.w, i)) ov++;
+        bool warned = j.n && lines_of(j.out, "jump")[0].find(kOverlapWarning) != std::string::npos;
+        char tag[160];
+        std::snprintf(tag, sizeof tag, "sweep %-12s (scale %.2f, feet %.0f, x %.1f, %.1f px/f%s), overlap %2d frames, warned %d",
+                      v.name, v.w.scale, v.w.feet_y_px, v.w.x0_px, v.w.v_px, v.w.behind ? ", behind" : "", ov, warned);
+        print_jump(tag, j);
+        std::string e;
+        if (j.n > 1) e += " extra flight;";
+        if (j.sessions != 2) e += " session split;";
+        if (j.accepted && std::fabs(j.h - g_clean_jump.h) > 0.02 * g_clean_jump.h && !warned) e += " wrong height accepted without a warning;";
+        if (j.accepted && std::fabs(j.h - g_clean_jump.h) > 0.02 * g_clean_jump.h && warned) e += " wrong height accepted (warned);";
+        if (j.accepted && ov > 0 && !warned) e += " overlapped flight accepted without a warning;";
+        if (!j.accepted && ov > 0 && !warned) e += " overlapped flight without other_motion;";
+        if (!e.empty()) {
+            bad++;
+            why += std::string(v.name) + ":" + e + " ";
+        }
+    }
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, bad, why.c_str());
+}
+
 int main(void)
 {
     std::snprintf(g_gym, sizeof g_gym, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
@@ -418,11 +553,31 @@ int main(void)
             std::fclose(f);
             g_off_cfg = off;
         }
-        if (write_clip(clean, nullptr) && write_clip(cross, &w) && write_clip(cross_b, &wb)) {
+        bool ok = write_clip(clean, nullptr) && write_clip(cross, &w) && write_clip(cross_b, &wb);
+        if (ok) {
             g_clean = clean;
             g_cross = cross;
             g_cross_b = cross_b;
-        } else {
+            g_clean_kp = keypoints(clean);
+            cv::Size fs(720, 1280);
+            {
+                cv::VideoCapture cap(clean);
+                cv::Mat fr;
+                if (cap.read(fr)) fs = fr.size();
+            }
+            for (const std::vector<gs_kp> &k : g_clean_kp) g_masks.push_back(body_mask(k, fs));
+            g_sweep = {{"speed 15", walk(1.55, 1100, 2.5, 15.0, false), ""},
+                       {"speed 20", walk(1.55, 1100, 2.5, 20.0, false), ""},
+                       {"scale 1.45", walk(1.45, 1100, 2.5, 17.5, false), ""},
+                       {"scale 1.65", walk(1.65, 1100, 2.5, 17.5, false), ""},
+                       {"start x 30", walk(1.55, 1100, 30.0, 17.5, false), ""},
+                       {"behind", walk(1.45, 1000, 2.5, 17.5, true), ""}};
+            for (size_t i = 0; ok && i < g_sweep.size(); i++) {
+                g_sweep[i].clip = g_dir + "/sweep" + std::to_string(i) + ".avi";
+                ok = write_clip(g_sweep[i].clip, &g_sweep[i].w);
+            }
+        }
+        if (!ok) {
             std::fprintf(stderr, "cannot write the FFV1 clips in %s\n", g_dir.c_str());
             return 1;
         }
@@ -435,8 +590,12 @@ int main(void)
     RUN_TEST(test_apex_crossing_keeps_the_jump);
     RUN_TEST(test_apex_crossing_without_the_keeper_is_corrupted);
     RUN_TEST(test_landing_crossing_does_not_take_the_track);
+    RUN_TEST(test_sweep_keeps_the_promise);
     int rc = UNITY_END();
-    if (!g_dir.empty()) {
+    if (!g_dir.empty() && std::getenv("GS_KEEP_CLIPS")) {
+        std::printf("clips kept in %s\n", g_dir.c_str());
+    } else if (!g_dir.empty()) {
+        for (size_t i = 0; i < g_sweep.size(); i++) std::remove(g_sweep[i].clip.c_str());
         std::remove((g_dir + "/clean.avi").c_str());
         std::remove((g_dir + "/crossing.avi").c_str());
         std::remove((g_dir + "/crossing_b.avi").c_str());

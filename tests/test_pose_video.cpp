@@ -144,7 +144,8 @@ static void test_missing_models_is_a_clear_error(void)
 
 // a jumper at 60 fps: toes on the ground row 900 px, off at t0, back at t1, flying
 // under a = 2000 px/s^2; the camera still or drifting; the body 600 px tall
-static void synth(gs::SceneWatch &w, double t0, double t1, double drift_px_s, double border_at)
+static void synth(gs::SceneWatch &w, double t0, double t1, double drift_px_s, double border_at,
+                  double other_from = -1.0, double other_to = -1.0)
 {
     const double a = 2000.0, g = 900.0, v0 = 0.5 * a * (t1 - t0);
     for (int i = 0; i <= 150; i++) {
@@ -158,6 +159,7 @@ static void synth(gs::SceneWatch &w, double t0, double t1, double drift_px_s, do
         f.feet_y_px = (t > t0 && t < t1) ? g - v0 * (t - t0) + 0.5 * a * (t - t0) * (t - t0) : g;
         f.ground_y_px = f.feet_y_px;
         f.at_border = std::fabs(t - border_at) < 0.02;
+        f.other = (t >= other_from && t <= other_to) ? 8 : 1;  // corners moving beside the body
         w.add(f);
     }
 }
@@ -182,6 +184,14 @@ static void test_scene_watch_feet_timing_and_warnings(void)
     gs::SceneWatch slow;  // 5 px/s: 2.5 px over the flight, below 6 px
     synth(slow, t0, t1, 5.0, -1.0);
     TEST_ASSERT_EQUAL_UINT32(0, slow.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
+    // someone moving beside the body: 3 frames of the window (60 fps) warn, 2 do not
+    gs::SceneWatch other, brief, outside;
+    synth(other, t0, t1, 0.0, -1.0, 1.0, 1.0 + 2.5 / 60.0);
+    TEST_ASSERT_EQUAL_UINT32(GS_WARN_OTHER_MOTION, other.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
+    synth(brief, t0, t1, 0.0, -1.0, 1.0, 1.0 + 1.5 / 60.0);
+    TEST_ASSERT_EQUAL_UINT32(0, brief.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
+    synth(outside, t0, t1, 0.0, -1.0, 0.0, 0.6);  // before the take-off (window: from t0 - 0.1 s)
+    TEST_ASSERT_EQUAL_UINT32(0, outside.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
 }
 
 int main(void)

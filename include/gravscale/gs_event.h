@@ -23,7 +23,8 @@ typedef enum {
     GS_REJ_IMPLAUSIBLE_A,   /* "implausible_acceleration" */
     GS_REJ_NO_SIZE,         /* "no_size": no standing pixel size known around the flight */
     GS_REJ_UNCERTAIN_A,     /* "uncertain_acceleration": relative SE of a too large */
-    GS_REJ_GAP              /* "gap": frames missing inside the flight */
+    GS_REJ_GAP,             /* "gap": frames missing inside the flight */
+    GS_REJ_OTHER_MOTION     /* "other_motion": from the front end: something else moved beside the body through much of the flight */
 } gs_reject_reason;
 
 /* warning bits of a jump */
@@ -36,6 +37,7 @@ typedef enum {
 #define GS_WARN_CAMERA_MOVED  0x20u /* "camera_moved": the background moved during the flight (not a static camera) */
 #define GS_WARN_LEFT_FRAME    0x40u /* "left_frame": the body touched the frame's border during the flight */
 #define GS_WARN_OUT_OF_PLANE  0x80u /* "out_of_plane": the body moved toward or away from the camera */
+#define GS_WARN_OTHER_MOTION  0x100u /* "other_motion": something else moved right beside the body during the flight */
 
 const char *gs_reject_reason_name(gs_reject_reason r);
 

@@ -11,6 +11,11 @@
 #include "gs_config.h"
 #include "gs_session.h"
 
+/* The front end's say on a flight before it is reported and aggregated: it may
+ * add warnings or reject it (accepted = false and a reason), from what the
+ * frames show and the keypoints cannot (the core cannot see the frames). */
+typedef void (*gs_jump_judge_fn)(void *ctx, gs_ev_jump *jump);
+
 typedef struct {
     gs_core_config cfg;
     gs_layout layout;
@@ -21,6 +26,8 @@ typedef struct {
     bool sessions;
     gs_event_fn on_event;
     void *ctx;
+    gs_jump_judge_fn judge;    /* NULL: none */
+    void *judge_ctx;
     double last_t_s;
     uint64_t n_frames;
     bool finished;
@@ -36,6 +43,8 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
 /* Number this pipeline's object: every jump/height/summary event carries it
  * (one pipeline per tracked object when several are followed). Default 0. */
 void gs_pipeline_set_track(gs_pipeline *p, uint32_t track);
+/* A judge for every flight (see gs_jump_judge_fn); NULL removes it. */
+void gs_pipeline_set_judge(gs_pipeline *p, gs_jump_judge_fn fn, void *ctx);
 /* Also emit GS_EV_STATE / GS_EV_SAMPLE / GS_EV_FIT trace events. */
 void gs_pipeline_set_trace(gs_pipeline *p, bool on);
 

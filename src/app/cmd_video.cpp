@@ -368,6 +368,18 @@ void on_event(void *ctx, const gs_event *ev)
         a.emit_fail++;
 }
 
+// The frames' say on a flight before the core reports and aggregates it: something
+// else moving right beside the person through much of the flight rejects it.
+void judge_jump(void *ctx, gs_ev_jump *j)
+{
+    App &a = *static_cast<App *>(ctx);
+    if (!a.watch || !j->accepted) return;
+    if (a.watch->other_rejects(j->t_takeoff_s, j->t_land_s, j->t_apex_s)) {
+        j->accepted = false;
+        j->reason = GS_REJ_OTHER_MOTION;
+    }
+}
+
 // One core pipeline per tracked ball.
 struct TrackPipe {
     gs_pipeline p;
@@ -392,6 +404,7 @@ public:
             }
             gs_pipeline_set_track(&tp->p, static_cast<uint32_t>(pipes_.size()));
             gs_pipeline_set_trace(&tp->p, app_.trace_on);
+            gs_pipeline_set_judge(&tp->p, judge_jump, &app_);
             pipes_.push_back(std::move(tp));
         }
         return &pipes_[track]->p;
@@ -502,6 +515,7 @@ struct PersonFront {
         sf->cam_valid = cm.valid;
         sf->cam_dx_px = cm.dx_px;
         sf->cam_dy_px = cm.dy_px;
+        sf->other = cm.other;
         sf->present = po->present;
         sf->ground_y_px = NAN;
         sf->size_px = NAN;

@@ -132,7 +132,8 @@ static size_t w_finish(gs_w *w)
 
 /* names of the GS_WARN_* bits, in bit order (protocol names) */
 static const char *const k_warn_names[] = {"few_samples", "gravity_tilt", "size_changed", "outliers",
-                                           "edge_truncated", "camera_moved", "left_frame", "out_of_plane"};
+                                           "edge_truncated", "camera_moved", "left_frame", "out_of_plane",
+                                           "other_motion"};
 
 /* ,"warnings":[names of the known set bits, in bit order] */
 static void w_warnings(gs_w *w, uint32_t bits)

@@ -20,6 +20,12 @@ size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
 static void on_flight_event(void *ctx, const gs_event *ev)
 {
     gs_pipeline *p = (gs_pipeline *)ctx;
+    gs_event judged;
+    if (ev->type == GS_EV_JUMP && p->judge) {
+        judged = *ev;
+        p->judge(p->judge_ctx, &judged.u.jump);
+        ev = &judged;
+    }
     if (p->on_event) p->on_event(p->ctx, ev);
     if (ev->type != GS_EV_JUMP) return;
     if (GS_WITH_POSE && p->sessions) gs_session_jump(&p->session, &ev->u.jump);
@@ -65,6 +71,13 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
 void gs_pipeline_set_track(gs_pipeline *p, uint32_t track)
 {
     if (p) p->flight.track = track;
+}
+
+void gs_pipeline_set_judge(gs_pipeline *p, gs_jump_judge_fn fn, void *ctx)
+{
+    if (!p) return;
+    p->judge = fn;
+    p->judge_ctx = ctx;
 }
 
 void gs_pipeline_set_trace(gs_pipeline *p, bool on)

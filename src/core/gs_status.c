@@ -31,6 +31,7 @@ const char *gs_reject_reason_name(gs_reject_reason r)
     case GS_REJ_NO_SIZE: return "no_size";
     case GS_REJ_UNCERTAIN_A: return "uncertain_acceleration";
     case GS_REJ_GAP: return "gap";
+    case GS_REJ_OTHER_MOTION: return "other_motion";
     }
     return "unknown";
 }

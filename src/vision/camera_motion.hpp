@@ -16,6 +16,12 @@ struct CameraMotionConfig {
     double work_width_px = 640.0;  // frames are reduced to at most this width
     double min_spacing_px = 12.0;  // between corners, at the working width
     int min_inliers = 12;          // fewer: the frame's motion is unknown
+    // something else moving next to a subject: corners in a ring around each
+    // excluded region (its size x ring_rel beyond the region's own margin) that
+    // move against the background's motion by more than other_px (full-frame px)
+    double ring_rel = 0.5;
+    int ring_features = 60;
+    double other_px = 4.0;
 };
 
 // The camera's motion at one frame, in full-frame pixels.
@@ -27,6 +33,7 @@ struct CameraMotionFrame {
     double scale = 1.0;            // zoom since the first frame
     double step_px = 0.0;          // displacement of the image centre since the previous frame
     int inliers = 0;
+    int other = 0;                 // corners around the subjects moving against the background
 };
 
 class CameraMotion {
@@ -38,6 +45,7 @@ public:
     cv::Point2d to_reference(cv::Point2d p) const;
 
 private:
+    int other_motion(const cv::Mat &cur, const std::vector<cv::Rect> &ex, const cv::Mat &m) const;
     CameraMotionConfig cfg_;
     double scale_ = 1.0;           // working / full
     std::vector<cv::Mat> prev_pyr_; // previous working grey frame's Lucas-Kanade pyramid

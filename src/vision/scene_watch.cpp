@@ -58,11 +58,35 @@ uint32_t SceneWatch::flight_warnings(double t0, double t1, double t_apex) const
     double size = median(sizes);
     double thr = std::max(cfg_.cam_moved_min_px, std::isfinite(size) ? cfg_.cam_moved_rel * size : 0.0);
     if (moved > thr) w |= GS_WARN_CAMERA_MOVED;
+    // someone (something) moved right beside the body: its keypoints may have followed
+    int frames = 0;
+    if (other_motion(t0, t1, t_apex, &frames) >= cfg_.other_frames) w |= GS_WARN_OTHER_MOTION;
     // the feet land on another row: the body moved in depth (or the camera tilted)
     double gb = median(before), ga = median(after);
     if (std::isfinite(gb) && std::isfinite(ga) && std::isfinite(size) && std::fabs(ga - gb) > cfg_.depth_rel * size)
         w |= GS_WARN_OUT_OF_PLANE;
     return w;
+}
+
+int SceneWatch::other_motion(double t0, double t1, double t_apex, int *frames) const
+{
+    *frames = 0;
+    if (!std::isfinite(t0)) t0 = t_apex - 0.3;
+    if (!std::isfinite(t1)) t1 = t_apex + 0.3;
+    if (!std::isfinite(t0) || !std::isfinite(t1)) return 0;
+    int n = 0;
+    for (const SceneFrame &f : frames_) {
+        if (f.t_s < t0 - cfg_.margin_s || f.t_s > t1 + cfg_.margin_s) continue;
+        (*frames)++;
+        if (f.other >= cfg_.other_corners) n++;
+    }
+    return n;
+}
+
+bool SceneWatch::other_rejects(double t0, double t1, double t_apex) const
+{
+    int frames = 0, n = other_motion(t0, t1, t_apex, &frames);
+    return n >= cfg_.other_frames && n >= cfg_.other_reject * frames;
 }
 
 namespace {
