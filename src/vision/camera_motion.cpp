@@ -96,7 +96,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
                 cv::Matx23d step(m.at<double>(0, 0), m.at<double>(0, 1), m.at<double>(0, 2) / scale_,
                                  m.at<double>(1, 0), m.at<double>(1, 1), m.at<double>(1, 2) / scale_);
                 cur_from_ref_ = compose(step, cur_from_ref_);
-                out->other = other_motion(cur, ex, m);
+                out->other = other_motion(pyr, ex, m);
                 cv::Point2d c(0.5 * full_.width, 0.5 * full_.height);
                 out->step_px = cv::norm(apply(step, c) - c);
                 out->inliers = n_in;
@@ -150,11 +150,12 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
 // them), followed into this frame: those that move against the background's
 // step m (working pixels) by more than other_px belong to something else moving
 // right beside a subject (a passer-by behind or next to the person).
-int CameraMotion::other_motion(const cv::Mat &cur, const std::vector<cv::Rect> &ex, const cv::Mat &m) const
+int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vector<cv::Rect> &ex, const cv::Mat &m) const
 {
-    if (ex.empty() || cfg_.ring_features <= 0) return 0;
-    cv::Rect all(0, 0, prev_.cols, prev_.rows);
-    cv::Mat mask(prev_.size(), CV_8U, cv::Scalar(0));
+    if (ex.empty() || cfg_.ring_features <= 0 || prev_pyr_.empty()) return 0;
+    const cv::Mat &prev = prev_pyr_[0];  // level 0: the previous working grey frame
+    cv::Rect all(0, 0, prev.cols, prev.rows);
+    cv::Mat mask(prev.size(), CV_8U, cv::Scalar(0));
     for (const cv::Rect &r : ex) {
         int g = (int)std::lround(cfg_.ring_rel * std::max(r.width, r.height));
         mask(cv::Rect(r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g) & all).setTo(255);
@@ -165,11 +166,11 @@ int CameraMotion::other_motion(const cv::Mat &cur, const std::vector<cv::Rect> &
     cv::Rect box = cv::boundingRect(mask);
     box.x &= ~1;
     box.y &= ~1;
-    box.width = std::min(prev_.cols - box.x, (box.width + 3) & ~1);
-    box.height = std::min(prev_.rows - box.y, (box.height + 3) & ~1);
+    box.width = std::min(prev.cols - box.x, (box.width + 3) & ~1);
+    box.height = std::min(prev.rows - box.y, (box.height + 3) & ~1);
     if (box.width < 8 || box.height < 8) return 0;
     cv::Mat half, half_mask;
-    cv::resize(prev_(box), half, cv::Size(box.width / 2, box.height / 2), 0, 0, cv::INTER_AREA);
+    cv::resize(prev(box), half, cv::Size(box.width / 2, box.height / 2), 0, 0, cv::INTER_AREA);
     cv::resize(mask(box), half_mask, half.size(), 0, 0, cv::INTER_NEAREST);
     std::vector<cv::Point2f> p0, p1;
     cv::goodFeaturesToTrack(half, p0, cfg_.ring_features, 0.01, 0.25 * cfg_.min_spacing_px, half_mask, 3);
@@ -177,7 +178,7 @@ int CameraMotion::other_motion(const cv::Mat &cur, const std::vector<cv::Rect> &
     for (cv::Point2f &p : p0) p = cv::Point2f(2.0f * p.x + 0.5f + (float)box.x, 2.0f * p.y + 0.5f + (float)box.y);
     std::vector<uchar> st;
     std::vector<float> err;
-    cv::calcOpticalFlowPyrLK(prev_, cur, p0, p1, st, err, cv::Size(21, 21), 3);
+    cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, p0, p1, st, err, cv::Size(21, 21), 3);  // both pyramids built once
     const double thr = cfg_.other_px * scale_;
     int n = 0;
     for (size_t i = 0; i < p0.size(); i++) {

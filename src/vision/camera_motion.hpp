@@ -45,7 +45,7 @@ public:
     cv::Point2d to_reference(cv::Point2d p) const;
 
 private:
-    int other_motion(const cv::Mat &cur, const std::vector<cv::Rect> &ex, const cv::Mat &m) const;
+    int other_motion(const std::vector<cv::Mat> &pyr, const std::vector<cv::Rect> &ex, const cv::Mat &m) const;
     CameraMotionConfig cfg_;
     double scale_ = 1.0;           // working / full
     std::vector<cv::Mat> prev_pyr_; // previous working grey frame's Lucas-Kanade pyramid
