@@ -31,6 +31,8 @@ extern "C" {
 #include "unity.h"
 }
 
+#include "gs_test_util.hpp"
+
 extern char **environ;
 
 void setUp(void) {}
@@ -38,64 +40,18 @@ void tearDown(void) {}
 
 namespace {
 
-constexpr double kG = 9.81;
+using gs_test::ball_at;
+using gs_test::draw_disc;
+using gs_test::num;
+using gs_test::slurp;
+
 std::string g_dir, g_clip;
 
 // ---- the clip: a ball thrown n times (as tests/test_video.cpp) --------------------
 
-struct Scene {
-    int width = 640, height = 480;
-    double q_m_per_px = 0.004, diameter_m = 0.08;  // 20 px
+struct Scene : gs_test::BallScene {
     double fps = 60.0;
-    int n_throws = 3;
-    double flight_s = 0.8, rest_s = 0.5, empty_s = 0.3;
-    double x0_px = 150.0, y_rest_px = 400.0, drift_px_s = 100.0;
 };
-
-double a_px(const Scene &s) { return kG / s.q_m_per_px; }
-
-bool ball_at(const Scene &s, double t_clip, double &x, double &y, bool &visible)
-{
-    visible = t_clip >= s.empty_s;
-    const double t = std::max(0.0, t_clip - s.empty_s);
-    const double a = a_px(s), v_up = 0.5 * a * s.flight_s, cycle = s.rest_s + s.flight_s;
-    int k = static_cast<int>(std::floor(t / cycle));
-    if (k > s.n_throws) return false;
-    double x_base = s.x0_px + s.drift_px_s * s.flight_s * std::min(k, s.n_throws);
-    double tc = t - k * cycle;
-    x = x_base;
-    y = s.y_rest_px;
-    if (k == s.n_throws) return tc <= s.rest_s;
-    if (tc > s.rest_s) {
-        double tf = tc - s.rest_s;
-        y = s.y_rest_px - v_up * tf + 0.5 * a * tf * tf;
-        x = x_base + s.drift_px_s * tf;
-    }
-    return true;
-}
-
-// A disc with each pixel blended by its covered fraction (16 x 16 sub-samples).
-void draw_disc(cv::Mat &img, double cx, double cy, double r, cv::Vec3b color)
-{
-    const int ss = 16;
-    int x0 = std::max(0, static_cast<int>(std::floor(cx - r - 1))), x1 = std::min(img.cols - 1, static_cast<int>(std::ceil(cx + r + 1)));
-    int y0 = std::max(0, static_cast<int>(std::floor(cy - r - 1))), y1 = std::min(img.rows - 1, static_cast<int>(std::ceil(cy + r + 1)));
-    for (int y = y0; y <= y1; y++)
-        for (int x = x0; x <= x1; x++) {
-            int in = 0;
-            for (int j = 0; j < ss; j++) {
-                double py = y + (j + 0.5) / ss - 0.5 - cy;
-                for (int i = 0; i < ss; i++) {
-                    double px = x + (i + 0.5) / ss - 0.5 - cx;
-                    in += px * px + py * py <= r * r;
-                }
-            }
-            if (in == 0) continue;
-            double a = static_cast<double>(in) / (ss * ss);
-            cv::Vec3b &p = img.at<cv::Vec3b>(y, x);
-            for (int c = 0; c < 3; c++) p[c] = cv::saturate_cast<uchar>(a * color[c] + (1 - a) * p[c]);
-        }
-}
 
 int scene_frames(const Scene &s) { return static_cast<int>((s.empty_s + s.n_throws * (s.rest_s + s.flight_s) + s.rest_s) * s.fps); }
 
@@ -124,44 +80,12 @@ void write_text(const std::string &path, const std::string &text)
     TEST_ASSERT_EQUAL_INT(0, std::fclose(f));
 }
 
-std::string slurp(const std::string &path)
-{
-    FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f) return "";
-    std::string s;
-    char buf[65536];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
-    std::fclose(f);
-    return s;
-}
-
 double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
+// the log and the pty may end mid-line: whole lines only, each opening with its event
 std::vector<std::string> lines_of(const std::string &out, const char *event)
 {
-    std::vector<std::string> v;
-    std::string pat = std::string("{\"event\":\"") + event + "\"";
-    size_t p = 0;
-    while (p < out.size()) {
-        size_t nl = out.find('\n', p);
-        if (nl == std::string::npos) break;
-        std::string line = out.substr(p, nl - p);
-        if (line.compare(0, pat.size(), pat) == 0) v.push_back(line);
-        p = nl + 1;
-    }
-    return v;
-}
-
-double num(const std::string &line, const char *key)
-{
-    std::string pat = std::string("\"") + key + "\":";
-    size_t k = line.find(pat);
-    if (k == std::string::npos) return NAN;
-    const char *s = line.c_str() + k + pat.size();
-    char *end;
-    double v = std::strtod(s, &end);
-    return end == s ? NAN : v;
+    return gs_test::lines_of(out, event, gs_test::kAtLineStart | gs_test::kWholeLinesOnly);
 }
 
 // The daemon as a child: stderr on a pipe read here, stdout to a file.

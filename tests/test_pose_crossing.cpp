@@ -35,6 +35,7 @@ extern "C" {
 
 #include "pose_blazepose.hpp"
 #include "pose_look.hpp"
+#include "gs_test_util.hpp"
 
 #ifndef GS_SHARED_DIR
 #error "GS_SHARED_DIR must be defined"
@@ -44,6 +45,11 @@ void setUp(void) {}
 void tearDown(void) {}
 
 namespace {
+
+using gs_test::exists;
+using gs_test::Run;
+using gs_test::lines_of;
+using gs_test::num;
 
 const char *const kWalkerPhoto = "/usr/share/doc/opencv-doc/examples/data/basketball1.png";
 // the man on the left of basketball1.png, outlined by hand on a 10 px grid
@@ -72,12 +78,6 @@ const char *const kOverlapWarning = "\"other_motion\"";
 
 std::string g_dir, g_clean, g_cross;
 char g_gym[512];
-
-bool exists(const char *p)
-{
-    struct stat st;
-    return stat(p, &st) == 0;
-}
 
 // The gym clip re-written as FFV1 at 30 fps (the mp4's times are i/30 s), with
 // the walker pasted when w is given.
@@ -128,49 +128,9 @@ bool write_clip(const std::string &out, const Walk *w)
     return vw.isOpened();
 }
 
-struct Run {
-    int code = -1;
-    std::string out;
-};
-
 Run run(const std::string &args)
 {
-    std::string cmd = std::string(GS_PROGRAM) + " video " + args + " 2>/dev/null";
-    Run r;
-    FILE *p = popen(cmd.c_str(), "r");
-    TEST_ASSERT_NOT_NULL(p);
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-    int st = pclose(p);
-    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
-    return r;
-}
-
-std::vector<std::string> lines_of(const std::string &out, const std::string &event)
-{
-    std::vector<std::string> v;
-    std::string pat = "\"event\":\"" + event + "\"";
-    size_t p = 0;
-    while (p < out.size()) {
-        size_t nl = out.find('\n', p);
-        if (nl == std::string::npos) nl = out.size();
-        std::string line = out.substr(p, nl - p);
-        if (line.find(pat) != std::string::npos) v.push_back(line);
-        p = nl + 1;
-    }
-    return v;
-}
-
-double num(const std::string &line, const char *key)
-{
-    std::string pat = std::string("\"") + key + "\":";
-    size_t k = line.find(pat);
-    if (k == std::string::npos) return NAN;
-    const char *s = line.c_str() + k + pat.size();
-    char *end;
-    double v = std::strtod(s, &end);
-    return end == s ? NAN : v;
+    return gs_test::run_shell(std::string(GS_PROGRAM) + " video " + args, "/dev/null");
 }
 
 // the tracked hip centre per frame (NaN when no pose)

@@ -7,8 +7,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <sys/stat.h>
@@ -21,6 +19,7 @@ extern "C" {
 
 #include "pose_blazepose.hpp"
 #include "prefetch.hpp"
+#include "gs_test_util.hpp"
 
 #ifndef GS_SHARED_DIR
 #error "GS_SHARED_DIR must be defined"
@@ -31,19 +30,7 @@ void tearDown(void) {}
 
 namespace {
 
-bool exists(const char *p)
-{
-    struct stat st;
-    return stat(p, &st) == 0;
-}
-
-std::string read_all(const std::string &path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using gs_test::exists;
 
 struct Run {
     int code = -1;
@@ -54,17 +41,12 @@ Run run(const std::string &clip, const std::string &args)
 {
     const std::string trace = "/tmp/gs_test_pose_prefetch.trace.jsonl";
     std::remove(trace.c_str());
-    std::string cmd = std::string(GS_PROGRAM) + " video '" + clip + "' --detector pose --trace " + trace + " " + args +
-                      " 2>/tmp/gs_test_pose_prefetch.err";
+    std::string cmd = std::string(GS_PROGRAM) + " video '" + clip + "' --detector pose --trace " + trace + " " + args;
+    gs_test::Run sh = gs_test::run_shell(cmd, "/tmp/gs_test_pose_prefetch.err");
     Run r;
-    FILE *p = popen(cmd.c_str(), "r");
-    TEST_ASSERT_NOT_NULL(p);
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-    int st = pclose(p);
-    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
-    r.trace = read_all(trace);
+    r.code = sh.code;
+    r.out = sh.out;
+    r.trace = gs_test::slurp(trace);
     std::remove(trace.c_str());
     return r;
 }

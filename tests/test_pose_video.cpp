@@ -20,6 +20,7 @@ extern "C" {
 }
 
 #include "scene_watch.hpp"
+#include "gs_test_util.hpp"
 
 #ifndef GS_SHARED_DIR
 #error "GS_SHARED_DIR must be defined"
@@ -30,55 +31,14 @@ void tearDown(void) {}
 
 namespace {
 
-struct Run {
-    int code = -1;
-    std::string out;
-};
+using gs_test::exists;
+using gs_test::Run;
+using gs_test::lines_of;
+using gs_test::num;
 
 Run run(const std::string &args)
 {
-    std::string cmd = std::string(GS_PROGRAM) + " video " + args + " 2>/tmp/gs_test_pose_video.err";
-    Run r;
-    FILE *p = popen(cmd.c_str(), "r");
-    TEST_ASSERT_NOT_NULL(p);
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-    int st = pclose(p);
-    r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
-    return r;
-}
-
-std::vector<std::string> lines_of(const std::string &out, const std::string &event)
-{
-    std::vector<std::string> v;
-    std::string pat = "\"event\":\"" + event + "\"";
-    size_t p = 0;
-    while (p < out.size()) {
-        size_t nl = out.find('\n', p);
-        if (nl == std::string::npos) nl = out.size();
-        std::string line = out.substr(p, nl - p);
-        if (line.find(pat) != std::string::npos) v.push_back(line);
-        p = nl + 1;
-    }
-    return v;
-}
-
-double num(const std::string &line, const char *key)
-{
-    std::string pat = std::string("\"") + key + "\":";
-    size_t k = line.find(pat);
-    if (k == std::string::npos) return NAN;
-    const char *s = line.c_str() + k + pat.size();
-    char *end;
-    double v = std::strtod(s, &end);
-    return end == s ? NAN : v;
-}
-
-bool exists(const char *p)
-{
-    struct stat st;
-    return stat(p, &st) == 0;
+    return gs_test::run_shell(std::string(GS_PROGRAM) + " video " + args, "/tmp/gs_test_pose_video.err");
 }
 
 }  // namespace

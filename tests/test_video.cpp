@@ -31,6 +31,7 @@ extern "C" {
 }
 
 #include "frame_source.hpp"
+#include "gs_test_util.hpp"
 
 #ifndef GS_PROGRAM
 #error "GS_PROGRAM (path of the gravscale program) must be defined"
@@ -43,75 +44,25 @@ void tearDown(void) {}
 
 namespace {
 
-constexpr double kG = 9.81;
+using gs_test::a_px;
+using gs_test::ball_at;
+using gs_test::d_px;
+using gs_test::draw_disc;
+using gs_test::lines_of;
+using gs_test::num;
+using gs_test::slurp;
+
 std::string g_dir;
 int g_seq = 0;
 
 // ---- rendering ---------------------------------------------------------------
 
-struct Scene {
-    int width = 640, height = 480;
-    double q_m_per_px = 0.004;    // scale at the ball
-    double diameter_m = 0.08;     // 20 px
+// the ball scene (gs_test::BallScene) and its frame rates
+struct Scene : gs_test::BallScene {
     double true_fps = 60.0;       // frames per second of real time
     double stored_fps = 60.0;     // the rate written into the file
-    int n_throws = 3;
-    double flight_s = 0.8;        // real flight time of each throw
-    double rest_s = 0.5;          // resting before each throw and at the end
-    double empty_s = 0.3;         // the background alone at the start
     bool ball = true;
-    double x0_px = 150.0, y_rest_px = 400.0, drift_px_s = 100.0;
 };
-
-double a_px(const Scene &s) { return kG / s.q_m_per_px; }
-double d_px(const Scene &s) { return s.diameter_m / s.q_m_per_px; }
-
-// Ball centre at real time t; false once the scene is over.
-bool ball_at(const Scene &s, double t_clip, double &x, double &y, bool &visible)
-{
-    visible = t_clip >= s.empty_s;
-    const double t = std::max(0.0, t_clip - s.empty_s);
-    const double a = a_px(s), v_up = 0.5 * a * s.flight_s, cycle = s.rest_s + s.flight_s;
-    int k = static_cast<int>(std::floor(t / cycle));
-    if (k > s.n_throws) return false;
-    double x_base = s.x0_px + s.drift_px_s * s.flight_s * std::min(k, s.n_throws);
-    double tc = t - k * cycle;
-    x = x_base;
-    y = s.y_rest_px;
-    if (k == s.n_throws) return tc <= s.rest_s;
-    if (tc > s.rest_s) {
-        double tf = tc - s.rest_s;
-        y = s.y_rest_px - v_up * tf + 0.5 * a * tf * tf;
-        x = x_base + s.drift_px_s * tf;
-    }
-    return true;
-}
-
-// A disc of exactly this centre and radius: each pixel blended by its covered
-// fraction (16 x 16 sub-samples). cv::circle's anti-aliased disc is about half a
-// pixel too wide, which alone would bias a 50 px diameter by 2.5 %.
-void draw_disc(cv::Mat &img, double cx, double cy, double r, cv::Vec3b color)
-{
-    const int ss = 16;
-    int x0 = std::max(0, static_cast<int>(std::floor(cx - r - 1))), x1 = std::min(img.cols - 1, static_cast<int>(std::ceil(cx + r + 1)));
-    int y0 = std::max(0, static_cast<int>(std::floor(cy - r - 1))), y1 = std::min(img.rows - 1, static_cast<int>(std::ceil(cy + r + 1)));
-    for (int y = y0; y <= y1; y++) {
-        for (int x = x0; x <= x1; x++) {
-            int in = 0;
-            for (int j = 0; j < ss; j++) {
-                double py = y + (j + 0.5) / ss - 0.5 - cy;  // pixel (x, y) covers [x-0.5, x+0.5)
-                for (int i = 0; i < ss; i++) {
-                    double px = x + (i + 0.5) / ss - 0.5 - cx;
-                    in += px * px + py * py <= r * r;
-                }
-            }
-            if (in == 0) continue;
-            double a = static_cast<double>(in) / (ss * ss);
-            cv::Vec3b &p = img.at<cv::Vec3b>(y, x);
-            for (int c = 0; c < 3; c++) p[c] = cv::saturate_cast<uchar>(a * color[c] + (1 - a) * p[c]);
-        }
-    }
-}
 
 cv::Mat render_frame(const Scene &s, double t, bool *more)
 {
@@ -194,18 +145,6 @@ void write_bytes(const std::string &path, const std::string &bytes)
     TEST_ASSERT_EQUAL_INT(0, std::fclose(f));
 }
 
-std::string slurp(const std::string &path)
-{
-    FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f) return "";
-    std::string s;
-    char buf[65536];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
-    std::fclose(f);
-    return s;
-}
-
 // ---- running the program -----------------------------------------------------------
 
 struct Run {
@@ -239,33 +178,6 @@ Run run(std::vector<std::string> args)
     r.out = slurp(outp);
     r.err = slurp(errp);
     return r;
-}
-
-std::vector<std::string> lines_of(const std::string &out, const char *event)
-{
-    std::vector<std::string> v;
-    std::string pat = std::string("\"event\":\"") + event + "\"";
-    size_t p = 0;
-    while (p < out.size()) {
-        size_t nl = out.find('\n', p);
-        if (nl == std::string::npos) nl = out.size();
-        std::string line = out.substr(p, nl - p);
-        if (line.find(pat) != std::string::npos) v.push_back(line);
-        p = nl + 1;
-    }
-    return v;
-}
-
-// the number after "key": (NaN when null or absent)
-double num(const std::string &line, const char *key)
-{
-    std::string pat = std::string("\"") + key + "\":";
-    size_t k = line.find(pat);
-    if (k == std::string::npos) return NAN;
-    const char *s = line.c_str() + k + pat.size();
-    char *end;
-    double v = std::strtod(s, &end);
-    return end == s ? NAN : v;
 }
 
 std::string str(const std::string &line, const char *key)
