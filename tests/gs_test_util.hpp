@@ -12,6 +12,7 @@
 #include <string>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -23,6 +24,13 @@ extern "C" {
 namespace gs_test {
 
 // ---- files ----------------------------------------------------------------------
+
+// A scratch file of this process: two test runs at once (a developer's and CI's,
+// or two build trees) must not read each other's files.
+inline std::string tmp_path(const char *name)
+{
+    return "/tmp/" + std::string(name) + "." + std::to_string(static_cast<long>(getpid()));
+}
 
 inline bool exists(const char *path)
 {

@@ -39,10 +39,10 @@ struct Run {
 
 Run run(const std::string &clip, const std::string &args)
 {
-    const std::string trace = "/tmp/gs_test_pose_prefetch.trace.jsonl";
+    const std::string trace = gs_test::tmp_path("gs_test_pose_prefetch.trace.jsonl");
     std::remove(trace.c_str());
     std::string cmd = std::string(GS_PROGRAM) + " video '" + clip + "' --detector pose --trace " + trace + " " + args;
-    gs_test::Run sh = gs_test::run_shell(cmd, "/tmp/gs_test_pose_prefetch.err");
+    gs_test::Run sh = gs_test::run_shell(cmd, gs_test::tmp_path("gs_test_pose_prefetch.err"));
     Run r;
     r.code = sh.code;
     r.out = sh.out;

@@ -38,7 +38,7 @@ using gs_test::num;
 
 Run run(const std::string &args)
 {
-    return gs_test::run_shell(std::string(GS_PROGRAM) + " video " + args, "/tmp/gs_test_pose_video.err");
+    return gs_test::run_shell(std::string(GS_PROGRAM) + " video " + args, gs_test::tmp_path("gs_test_pose_video.err"));
 }
 
 }  // namespace
@@ -92,7 +92,7 @@ static void test_missing_models_is_a_clear_error(void)
     Run r = run("'" + clip + "' --detector pose --models /nonexistent/models");
     TEST_ASSERT_EQUAL_INT(2, r.code);
     TEST_ASSERT_EQUAL_INT(0, (int)r.out.size());
-    FILE *f = std::fopen("/tmp/gs_test_pose_video.err", "r");
+    FILE *f = std::fopen(gs_test::tmp_path("gs_test_pose_video.err").c_str(), "r");
     TEST_ASSERT_NOT_NULL(f);
     char line[1024] = {0};
     TEST_ASSERT_NOT_NULL(std::fgets(line, sizeof line, f));
