@@ -58,6 +58,8 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.hpp"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -223,69 +225,29 @@ int usage()
 
 int main(int argc, char **argv)
 {
-    const char *shared = std::getenv("GS_SHARED_DIR");
-    std::string clip = std::string(shared && *shared ? shared : "../shared") +
-                       "/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4";
+    std::string clip = gs_bench::gym_clip();
     std::string program = self_dir() + "/gravscale", models_dir, model_arg = "lite", res_arg = "both",
-                cpus_arg = "both", prefetch_arg = "both", threads_arg = "auto";
-    int n_frames = 540, repeat = 1;
+                cpus_arg = "both", prefetch_arg = "both", threads_arg = "auto", frames_arg = "540",
+                repeat_arg = "1", wait_arg = "0";
+    if (!gs_bench::parse_options(argc, argv,
+                                 {{"--program", &program}, {"--models", &models_dir}, {"--model", &model_arg},
+                                  {"--res", &res_arg}, {"--cpus", &cpus_arg}, {"--prefetch", &prefetch_arg},
+                                  {"--threads", &threads_arg}, {"--frames", &frames_arg}, {"--repeat", &repeat_arg},
+                                  {"--wait-idle", &wait_arg}},
+                                 &clip))
+        return usage();
+    int n_frames = 0, repeat = 0;
     double idle_wait_s = 0;
-    for (int i = 1; i < argc; i++) {
-        std::string a = argv[i];
-        auto val = [&](std::string &out) {
-            if (i + 1 >= argc) return false;
-            out = argv[++i];
-            return true;
-        };
-        std::string v;
-        if (a == "--program") { if (!val(program)) return usage(); }
-        else if (a == "--models") { if (!val(models_dir)) return usage(); }
-        else if (a == "--model") { if (!val(model_arg)) return usage(); }
-        else if (a == "--res") { if (!val(res_arg)) return usage(); }
-        else if (a == "--cpus") { if (!val(cpus_arg)) return usage(); }
-        else if (a == "--prefetch") { if (!val(prefetch_arg)) return usage(); }
-        else if (a == "--threads") { if (!val(threads_arg)) return usage(); }
-        else if (a == "--wait-idle") {
-            if (!val(v)) return usage();
-            idle_wait_s = std::atof(v.c_str());
-        }
-        else if (a == "--frames" || a == "--repeat") {
-            if (!val(v)) return usage();
-            int n = std::atoi(v.c_str());
-            if (n <= 0) return usage();
-            (a == "--frames" ? n_frames : repeat) = n;
-        } else if (!a.empty() && a[0] == '-') return usage();
-        else clip = a;
-    }
-    std::vector<std::string> models;
-    if (model_arg == "all") models = {"lite", "full", "heavy"};
-    else {  // one model or a comma-separated list
-        std::stringstream ss(model_arg);
-        std::string m;
-        while (std::getline(ss, m, ','))
-            if (m == "lite" || m == "full" || m == "heavy") models.push_back(m);
-            else return usage();
-        if (models.empty()) return usage();
-    }
+    std::vector<std::string> models, threads;  // OpenCV threads: auto (OpenCV's default: the CPUs allowed), 1, 2
     std::vector<int> heights, cpus, prefetch;
-    if (res_arg == "both") heights = {720, 1080};
-    else if (res_arg == "720" || res_arg == "1080") heights = {std::atoi(res_arg.c_str())};
-    else return usage();
-    if (cpus_arg == "both") cpus = {1, 2};
-    else if (cpus_arg == "1" || cpus_arg == "2") cpus = {std::atoi(cpus_arg.c_str())};
-    else return usage();
-    if (prefetch_arg == "both") prefetch = {0, 2};
-    else if (prefetch_arg == "0" || prefetch_arg == "2") prefetch = {std::atoi(prefetch_arg.c_str())};
-    else return usage();
-    std::vector<std::string> threads;  // OpenCV threads: auto (OpenCV's default: the CPUs allowed), 1, 2
-    {
-        std::stringstream ss(threads_arg);
-        std::string t;
-        while (std::getline(ss, t, ','))
-            if (t == "auto" || t == "1" || t == "2") threads.push_back(t);
-            else return usage();
-        if (threads.empty()) return usage();
-    }
+    if (!gs_bench::to_int(frames_arg, 1, n_frames) || !gs_bench::to_int(repeat_arg, 1, repeat) ||
+        !gs_bench::to_seconds(wait_arg, idle_wait_s) ||
+        !gs_bench::pick(model_arg, "all", {"lite", "full", "heavy"}, models) ||
+        !gs_bench::pick_ints(res_arg, "both", {"720", "1080"}, heights) ||
+        !gs_bench::pick_ints(cpus_arg, "both", {"1", "2"}, cpus) ||
+        !gs_bench::pick_ints(prefetch_arg, "both", {"0", "2"}, prefetch) ||
+        !gs_bench::pick(threads_arg, "both", {"auto", "1", "2"}, threads))
+        return usage();
     if (access(program.c_str(), X_OK) != 0) {
         std::fprintf(stderr, "bench_pipeline: %s: not a program (--program PATH)\n", program.c_str());
         return 1;

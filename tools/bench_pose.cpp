@@ -29,6 +29,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "bench_args.hpp"
 #include "pose_blazepose.hpp"
 
 namespace {
@@ -65,7 +66,7 @@ Stats stats(std::vector<double> v)
 int usage()
 {
     std::fprintf(stderr,
-                 "usage: bench_pose [CLIP] [--models DIR] [--frames N] [--model lite|full|heavy|all]\n"
+                 "usage: bench_pose [CLIP] [--models DIR] [--frames N (0: all)] [--model lite|full|heavy|all|lite,full]\n"
                  "                  [--threads 1|2|both] [--res 720|1080|both]\n");
     return 2;
 }
@@ -74,44 +75,24 @@ int usage()
 
 int main(int argc, char **argv)
 {
-    const char *shared = std::getenv("GS_SHARED_DIR");
-    std::string clip = std::string(shared && *shared ? shared : "../shared") +
-                       "/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4";
-    std::string models_dir, model_arg = "all", threads_arg = "both", res_arg = "both";
-    int max_frames = 0;
-    for (int i = 1; i < argc; i++) {
-        std::string a = argv[i];
-        auto val = [&](std::string &out) {
-            if (i + 1 >= argc) return false;
-            out = argv[++i];
-            return true;
-        };
-        std::string v;
-        if (a == "--models") { if (!val(models_dir)) return usage(); }
-        else if (a == "--model") { if (!val(model_arg)) return usage(); }
-        else if (a == "--threads") { if (!val(threads_arg)) return usage(); }
-        else if (a == "--res") { if (!val(res_arg)) return usage(); }
-        else if (a == "--frames") {
-            if (!val(v)) return usage();
-            max_frames = std::atoi(v.c_str());
-            if (max_frames <= 0) return usage();
-        } else if (!a.empty() && a[0] == '-') return usage();
-        else clip = a;
-    }
+    std::string clip = gs_bench::gym_clip();
+    std::string models_dir, model_arg = "all", threads_arg = "both", res_arg = "both", frames_arg = "0";
+    if (!gs_bench::parse_options(argc, argv,
+                                 {{"--models", &models_dir}, {"--model", &model_arg}, {"--threads", &threads_arg},
+                                  {"--res", &res_arg}, {"--frames", &frames_arg}},
+                                 &clip))
+        return usage();
+    int max_frames = 0;  // 0: the whole clip
+    std::vector<std::string> model_names;
+    std::vector<int> threads, heights;
+    if (!gs_bench::to_int(frames_arg, 0, max_frames) ||
+        !gs_bench::pick(model_arg, "all", {"lite", "full", "heavy"}, model_names) ||
+        !gs_bench::pick_ints(threads_arg, "both", {"1", "2"}, threads) ||
+        !gs_bench::pick_ints(res_arg, "both", {"720", "1080"}, heights))
+        return usage();
     std::vector<gs::PoseModel> models;
-    if (model_arg == "all") models = {gs::PoseModel::lite, gs::PoseModel::full, gs::PoseModel::heavy};
-    else if (model_arg == "lite") models = {gs::PoseModel::lite};
-    else if (model_arg == "full") models = {gs::PoseModel::full};
-    else if (model_arg == "heavy") models = {gs::PoseModel::heavy};
-    else return usage();
-    std::vector<int> threads;
-    if (threads_arg == "both") threads = {1, 2};
-    else if (threads_arg == "1" || threads_arg == "2") threads = {std::atoi(threads_arg.c_str())};
-    else return usage();
-    std::vector<int> heights;
-    if (res_arg == "both") heights = {720, 1080};
-    else if (res_arg == "720" || res_arg == "1080") heights = {std::atoi(res_arg.c_str())};
-    else return usage();
+    for (const std::string &m : model_names)
+        models.push_back(m == "lite" ? gs::PoseModel::lite : m == "full" ? gs::PoseModel::full : gs::PoseModel::heavy);
 
     cv::VideoCapture cap(clip);
     if (!cap.isOpened()) {

@@ -22,6 +22,7 @@
 
 extern "C" {
 #include "gravscale/gravscale.h"
+#include "app_common.h"
 #include "gs_kpread.h"
 #include "gs_profile.h"
 #include "gs_sink_config.h"
@@ -31,8 +32,7 @@ extern "C" int gs_cmd_cam(int argc, char **argv);
 
 namespace {
 
-enum { EXIT_OK = 0, EXIT_SOURCE = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
-constexpr size_t kConfigMaxBytes = 1u << 20;
+enum { EXIT_OK = GS_EXIT_OK, EXIT_SOURCE = GS_EXIT_DATA, EXIT_USAGE = GS_EXIT_USAGE, EXIT_IO = GS_EXIT_IO };
 constexpr int kStepMs = 10;  // the loop's longest wait for a frame: sinks are polled at least this often
 
 const char kHelp[] =
@@ -143,11 +143,7 @@ struct Options {
     gs_format out_format = GS_FMT_JSON;
 };
 
-int usage_error(const std::string &msg)
-{
-    std::fprintf(stderr, "gravscale: cam: %s (see gravscale cam --help)\n", msg.c_str());
-    return EXIT_USAGE;
-}
+int usage_error(const std::string &msg) { return gs_app_usage_error("cam", "%s", msg.c_str()); }
 
 bool parse_num(const std::string &s, double lo, double hi, double &out)
 {
@@ -176,17 +172,12 @@ int parse_args(int argc, char **argv, Options &o)
             o.check = true;
             continue;
         }
-        size_t eq = a.find('=');
-        std::string name = a.substr(0, eq), val;
-        bool known = false;
-        for (const char *k : with_value) known = known || name == k;
-        if (!known) return usage_error("unknown option '" + a + "'");
-        if (eq != std::string::npos) {
-            val = a.substr(eq + 1);
-        } else {
-            if (i + 1 >= argc) return usage_error("option '" + name + "' needs a value");
-            val = argv[++i];
-        }
+        char name_buf[32];
+        const char *val_c;
+        int rc = gs_app_option("cam", argc, argv, &i, with_value, sizeof with_value / sizeof with_value[0],
+                               name_buf, sizeof name_buf, &val_c);
+        if (rc >= 0) return rc;
+        const std::string name = name_buf, val = val_c;
         double d;
         if (name == "--config") {
             o.config = val;
@@ -232,14 +223,6 @@ int parse_args(int argc, char **argv, Options &o)
     return -1;
 }
 
-void print_cfg_error(const std::string &path, const gs_cfg_error &e)
-{
-    std::fprintf(stderr, "gravscale: %s:", path.c_str());
-    if (e.line > 0) std::fprintf(stderr, "%u:", static_cast<unsigned>(e.line));
-    if (e.section[0]) std::fprintf(stderr, " [%s]", e.section);
-    if (e.key[0]) std::fprintf(stderr, " key '%s'", e.key);
-    std::fprintf(stderr, "%s %s\n", (e.section[0] || e.key[0]) ? ":" : "", e.msg[0] ? e.msg : "invalid configuration");
-}
 
 struct Profile {
     gs_core_config core;
@@ -283,32 +266,22 @@ gs_status parse_profile(const std::string &text, Profile &p, bool small_object, 
 
 int load_profile(const Options &o, Profile &p)
 {
-    FILE *f = std::fopen(o.config.c_str(), "rb");
-    if (!f) {
-        std::fprintf(stderr, "gravscale: %s: cannot open config: %s\n", o.config.c_str(), std::strerror(errno));
-        return EXIT_USAGE;
-    }
-    std::string text(kConfigMaxBytes + 1, '\0');
-    size_t n = std::fread(&text[0], 1, text.size(), f);
-    bool bad = std::ferror(f) != 0;
-    std::fclose(f);
-    if (bad || n > kConfigMaxBytes) {
-        std::fprintf(stderr, "gravscale: %s: cannot read config (at most %u bytes)\n", o.config.c_str(),
-                     static_cast<unsigned>(kConfigMaxBytes));
-        return EXIT_USAGE;
-    }
-    text.resize(n);
+    size_t n = 0;
+    char *raw = gs_app_read_config(o.config.c_str(), &n);
+    if (!raw) return EXIT_USAGE;
+    std::string text(raw, n);
+    std::free(raw);
     gs_cfg_error e;
     // first pass: which detector (it sets the default size range), and every error
     if (parse_profile(text, p, false, e) != GS_OK) {
-        print_cfg_error(o.config, e);
+        gs_app_print_cfg_error(o.config.c_str(), &e);
         return EXIT_USAGE;
     }
     const std::string det = o.detector.empty() ? p.cam.detector : o.detector;
     const std::string backend = o.backend.empty() ? p.cam.cap.backend : o.backend;
     // keypoints come without a detector: the size range stays a person's
     if (backend != "keypoints" && gs::detector_is_small_object(det) && parse_profile(text, p, true, e) != GS_OK) {
-        print_cfg_error(o.config, e);
+        gs_app_print_cfg_error(o.config.c_str(), &e);
         return EXIT_USAGE;
     }
     // the command line wins

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "gravscale/gravscale.h"
+#include "app_common.h"
 #include "gs_kpread.h"
 #include "gs_out.h"
 #include "gs_profile.h"
@@ -18,10 +19,9 @@
 /* Declared in main.c as well (no app header yet). */
 int gs_cmd_replay(int argc, char **argv);
 
-enum { EXIT_OK = 0, EXIT_DATA = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
+enum { EXIT_OK = GS_EXIT_OK, EXIT_DATA = GS_EXIT_DATA, EXIT_USAGE = GS_EXIT_USAGE, EXIT_IO = GS_EXIT_IO };
 
 #define PREFETCH_FRAMES 32          /* frames whose intervals give fps_source */
-#define CONFIG_MAX_BYTES (1u << 20)
 #define TRACE_BUF_BYTES (1u << 16)
 
 static const char REPLAY_HELP[] =
@@ -103,10 +103,7 @@ typedef struct {
 
 static int usage_error(const char *fmt, const char *arg)
 {
-    fputs("gravscale: replay: ", stderr);
-    fprintf(stderr, fmt, arg);
-    fputs(" (see gravscale replay --help)\n", stderr);
-    return EXIT_USAGE;
+    return gs_app_usage_error("replay", fmt, arg);
 }
 
 /* Returns -1 to go on, else an exit code (help or usage error). */
@@ -122,30 +119,15 @@ static int parse_args(int argc, char **argv, replay_opts *o)
         }
         if (strncmp(a, "--", 2) != 0)
             return usage_error("unexpected argument '%s'", a);
-        /* "--name value" or "--name=value" */
-        char name[32];
-        const char *val;
-        const char *eq = strchr(a, '=');
-        size_t nl = eq ? (size_t)(eq - a) : strlen(a);
-        if (nl >= sizeof name)
-            return usage_error("unknown option '%s'", a);
-        memcpy(name, a, nl);
-        name[nl] = '\0';
         static const char *const known[] = {"--keypoints", "--format", "--layout",
                                             "--fps",       "--config", "--output-format",
                                             "--trace",     "--track"};
-        bool ok = false;
-        for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
-            ok = ok || strcmp(name, known[k]) == 0;
-        if (!ok)
-            return usage_error("unknown option '%s'", name);
-        if (eq) {
-            val = eq + 1;
-        } else {
-            if (i + 1 >= argc)
-                return usage_error("option '%s' needs a value", name);
-            val = argv[++i];
-        }
+        char name[32];
+        const char *val;
+        int rc = gs_app_option("replay", argc, argv, &i, known, sizeof known / sizeof known[0], name,
+                               sizeof name, &val);
+        if (rc >= 0)
+            return rc;
         if (strcmp(name, "--keypoints") == 0) {
             o->keypoints = val;
         } else if (strcmp(name, "--config") == 0) {
@@ -195,44 +177,15 @@ static int parse_args(int argc, char **argv, replay_opts *o)
 
 /* ---- config ------------------------------------------------------------- */
 
-static void print_cfg_error(const char *path, const gs_cfg_error *e)
-{
-    fprintf(stderr, "gravscale: %s:", path);
-    if (e->line > 0)
-        fprintf(stderr, "%u:", (unsigned)e->line);
-    if (e->section[0])
-        fprintf(stderr, " [%s]", e->section);
-    if (e->key[0])
-        fprintf(stderr, " key '%s'", e->key);
-    fprintf(stderr, "%s %s\n", (e->section[0] || e->key[0]) ? ":" : "",
-            e->msg[0] ? e->msg : "invalid configuration");
-}
-
 static int load_config(const char *path, gs_core_config *cfg)
 {
     gs_core_config_default(cfg);
     if (!path)
         return EXIT_OK;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "gravscale: %s: cannot open config: %s\n", path, strerror(errno));
+    size_t n;
+    char *text = gs_app_read_config(path, &n);
+    if (!text)
         return EXIT_USAGE;
-    }
-    char *text = malloc(CONFIG_MAX_BYTES + 1);
-    size_t n = text ? fread(text, 1, CONFIG_MAX_BYTES + 1, f) : 0;
-    bool bad = !text || ferror(f);
-    fclose(f);
-    if (bad) {
-        fprintf(stderr, "gravscale: %s: cannot read config\n", path);
-        free(text);
-        return EXIT_USAGE;
-    }
-    if (n > CONFIG_MAX_BYTES) {
-        fprintf(stderr, "gravscale: %s: config larger than %u bytes\n", path,
-                (unsigned)CONFIG_MAX_BYTES);
-        free(text);
-        return EXIT_USAGE;
-    }
     /* [core]; the other sections of a profile belong to video and cam (gs_profile.h) */
     gs_cfg_section sections[1 + GS_PROFILE_SECTIONS];
     static const char *const own[] = {"core"};
@@ -247,7 +200,7 @@ static int load_config(const char *path, gs_core_config *cfg)
         st = gs_core_config_check(cfg, &e);
     }
     if (st != GS_OK) {
-        print_cfg_error(path, &e);
+        gs_app_print_cfg_error(path, &e);
         return EXIT_USAGE;
     }
     return EXIT_OK;

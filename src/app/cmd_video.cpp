@@ -32,6 +32,7 @@
 
 extern "C" {
 #include "gravscale/gravscale.h"
+#include "app_common.h"
 #include "gs_out.h"
 #include "gs_profile.h"
 }
@@ -40,8 +41,7 @@ extern "C" int gs_cmd_video(int argc, char **argv);
 
 namespace {
 
-enum { EXIT_OK = 0, EXIT_DATA = 1, EXIT_USAGE = 2, EXIT_IO = 3 };
-constexpr size_t kConfigMaxBytes = 1u << 20;
+enum { EXIT_OK = GS_EXIT_OK, EXIT_DATA = GS_EXIT_DATA, EXIT_USAGE = GS_EXIT_USAGE, EXIT_IO = GS_EXIT_IO };
 constexpr size_t kTraceBufBytes = 1u << 16;
 
 const char kHelp[] =
@@ -100,11 +100,7 @@ struct Options {
     gs_format out_format = GS_FMT_JSON;
 };
 
-int usage_error(const std::string &msg)
-{
-    std::fprintf(stderr, "gravscale: video: %s (see gravscale video --help)\n", msg.c_str());
-    return EXIT_USAGE;
-}
+int usage_error(const std::string &msg) { return gs_app_usage_error("video", "%s", msg.c_str()); }
 
 // -1 to go on, else an exit code
 int parse_args(int argc, char **argv, Options &o)
@@ -123,17 +119,12 @@ int parse_args(int argc, char **argv, Options &o)
             o.input = a;
             continue;
         }
-        size_t eq = a.find('=');
-        std::string name = a.substr(0, eq), val;
-        bool ok = false;
-        for (const char *k : known) ok = ok || name == k;
-        if (!ok) return usage_error("unknown option '" + name + "'");
-        if (eq != std::string::npos) {
-            val = a.substr(eq + 1);
-        } else {
-            if (i + 1 >= argc) return usage_error("option '" + name + "' needs a value");
-            val = argv[++i];
-        }
+        char name_buf[32];
+        const char *val_c;
+        int rc = gs_app_option("video", argc, argv, &i, known, sizeof known / sizeof known[0], name_buf,
+                               sizeof name_buf, &val_c);
+        if (rc >= 0) return rc;
+        const std::string name = name_buf, val = val_c;
         if (name == "--detector") {
             if (val != "ball" && val != "pose") return usage_error("--detector must be ball or pose, not '" + val + "'");
             o.detector = val;
@@ -183,14 +174,6 @@ int parse_args(int argc, char **argv, Options &o)
 
 #if GS_HAVE_BALL_DETECTOR
 
-void print_cfg_error(const std::string &path, const gs_cfg_error &e)
-{
-    std::fprintf(stderr, "gravscale: %s:", path.c_str());
-    if (e.line > 0) std::fprintf(stderr, "%u:", static_cast<unsigned>(e.line));
-    if (e.section[0]) std::fprintf(stderr, " [%s]", e.section);
-    if (e.key[0]) std::fprintf(stderr, " key '%s'", e.key);
-    std::fprintf(stderr, "%s %s\n", (e.section[0] || e.key[0]) ? ":" : "", e.msg[0] ? e.msg : "invalid configuration");
-}
 
 int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::BallConfig &ball,
                 gs::PoseConfig &pose)
@@ -201,24 +184,9 @@ int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::B
         cfg.size_max_m = 0.5f;
     }
     if (path.empty()) return EXIT_OK;
-    FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f) {
-        std::fprintf(stderr, "gravscale: %s: cannot open config: %s\n", path.c_str(), std::strerror(errno));
-        return EXIT_USAGE;
-    }
-    std::string text(kConfigMaxBytes + 1, '\0');
-    size_t n = std::fread(&text[0], 1, text.size(), f);
-    bool bad = std::ferror(f) != 0;
-    std::fclose(f);
-    if (bad) {
-        std::fprintf(stderr, "gravscale: %s: cannot read config\n", path.c_str());
-        return EXIT_USAGE;
-    }
-    if (n > kConfigMaxBytes) {
-        std::fprintf(stderr, "gravscale: %s: config larger than %u bytes\n", path.c_str(),
-                     static_cast<unsigned>(kConfigMaxBytes));
-        return EXIT_USAGE;
-    }
+    size_t n = 0;
+    std::unique_ptr<char, decltype(&std::free)> text(gs_app_read_config(path.c_str(), &n), &std::free);
+    if (!text) return EXIT_USAGE;
     // [core], [ball] and [pose]; the other sections of a profile belong to cam (gs_profile.h)
     gs_cfg_section sections[3 + GS_PROFILE_SECTIONS] = {{"core", gs_core_config_set, &cfg},
                                                         {"ball", gs::ball_config_set, &ball},
@@ -227,7 +195,7 @@ int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::B
     size_t n_sections = 3 + gs_profile_foreign_sections(own, 3, sections + 3, GS_PROFILE_SECTIONS);
     gs_cfg_error e;
     std::memset(&e, 0, sizeof e);
-    gs_status st = gs_cfg_parse(text.data(), n, sections, n_sections, &e);
+    gs_status st = gs_cfg_parse(text.get(), n, sections, n_sections, &e);
     if (st == GS_OK) {
         std::memset(&e, 0, sizeof e);
         st = gs_core_config_check(&cfg, &e);
@@ -238,7 +206,7 @@ int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::B
         if (st != GS_OK) std::snprintf(e.section, sizeof e.section, "ball");
     }
     if (st != GS_OK) {
-        print_cfg_error(path, e);
+        gs_app_print_cfg_error(path.c_str(), &e);
         return EXIT_USAGE;
     }
     return EXIT_OK;

@@ -35,6 +35,16 @@ void gs_lineq_free(gs_lineq *q)
     memset(q, 0, sizeof *q);
 }
 
+int gs_lineq_take(gs_lineq *q, const char *line, size_t len)
+{
+    q->taken++;
+    if (len == 0 || line[len - 1] != '\n' || gs_lineq_push(q, line, len) != 0) {
+        q->refused++;
+        return -1;
+    }
+    return 0;
+}
+
 static void evict_oldest(gs_lineq *q)
 {
     q->head_seq++;

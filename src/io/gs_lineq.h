@@ -25,6 +25,8 @@ typedef struct {
     uint64_t next_seq;   /* number the next pushed line gets */
     uint64_t wpos;       /* bytes pushed so far (position of the next byte) */
     uint64_t evicted;    /* lines pushed out to make room */
+    uint64_t taken;      /* lines offered through gs_lineq_take */
+    uint64_t refused;    /* ... of them not stored: no final newline, or too long */
 } gs_lineq;
 
 /* max_lines >= 1 lines, cap_bytes of text (raised to GS_SINK_LINE_MAX). 0 or -1 (ENOMEM). */
@@ -32,6 +34,10 @@ int gs_lineq_init(gs_lineq *q, uint32_t max_lines, size_t cap_bytes);
 void gs_lineq_free(gs_lineq *q);
 /* Append a line (1..GS_SINK_LINE_MAX bytes), evicting the oldest as needed. 0, or -1 if too long. */
 int gs_lineq_push(gs_lineq *q, const char *line, size_t len);
+
+/* A sink's intake: count the line and store it when it is one whole line
+ * (ends in '\n'); 0, or -1 refused (counted). */
+int gs_lineq_take(gs_lineq *q, const char *line, size_t len);
 
 /* One reader: a position in the ring plus the line it is sending. */
 typedef struct {

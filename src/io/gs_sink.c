@@ -106,6 +106,15 @@ static void fd_info(const void *state, gs_sink_info *o)
     o->c.bytes_sent = f->out.bytes;
 }
 
+void gs_sink_counters_fill(gs_sink_counters *c, const gs_lineq *q, const gs_lineq_reader *r)
+{
+    c->lines_in = q->taken;
+    c->lines_sent = r->sent;
+    c->lines_dropped = r->dropped + gs_lineq_reader_lost(r, q) + q->refused;
+    c->bytes_sent = r->bytes;
+    c->lines_queued = gs_lineq_reader_pending(r, q);
+}
+
 static void fd_close(void *state)
 {
     fd_sink *f = state;

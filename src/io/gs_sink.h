@@ -66,6 +66,10 @@ typedef struct {
 /* ------------------------------------------------------------- sink configs */
 
 /* stdout or an already open descriptor (not owned), or a file created/truncated. */
+/* For a sink with one queue and one reader (serial, TCP client): its intake,
+ * sent, dropped (evicted, refused) and queued lines and its bytes. */
+void gs_sink_counters_fill(gs_sink_counters *c, const gs_lineq *q, const gs_lineq_reader *r);
+
 int gs_sink_fd_open(gs_sink *s, int fd, const char *name, char *err, size_t cap);
 int gs_sink_file_open(gs_sink *s, const char *path, char *err, size_t cap);
 

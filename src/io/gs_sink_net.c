@@ -112,7 +112,6 @@ typedef struct {
     uint16_t port;
     gs_lineq q;
     tcp_client *cl;       /* cfg.max_clients slots, fd -1 when free */
-    uint64_t in, bad;     /* lines given / refused (malformed or too long) */
     uint64_t gone_sent, gone_dropped, gone_bytes; /* totals of clients that left */
     uint64_t accepted, refused;
     int last_errno;
@@ -142,11 +141,8 @@ static void client_pump(tcp_server *s, tcp_client *c)
 static int tcp_write_line(void *state, const char *line, size_t len)
 {
     tcp_server *s = state;
-    s->in++;
-    if (len == 0 || line[len - 1] != '\n' || gs_lineq_push(&s->q, line, len) != 0) {
-        s->bad++;
+    if (gs_lineq_take(&s->q, line, len) != 0)
         return -1;
-    }
     for (uint32_t i = 0; i < s->cfg.max_clients; i++)
         if (s->cl[i].fd >= 0)
             client_pump(s, &s->cl[i]);
@@ -222,9 +218,9 @@ static void tcp_info(const void *state, gs_sink_info *o)
     snprintf(o->target, sizeof o->target, "%s", s->target);
     o->state = GS_SINK_UP;
     o->last_errno = s->last_errno;
-    o->c.lines_in = s->in;
+    o->c.lines_in = s->q.taken;
     o->c.lines_sent = s->gone_sent;
-    o->c.lines_dropped = s->gone_dropped + s->bad;
+    o->c.lines_dropped = s->gone_dropped + s->q.refused;
     o->c.bytes_sent = s->gone_bytes;
     o->c.reopens = s->accepted;
     o->c.refused = s->refused;
@@ -345,7 +341,7 @@ typedef struct {
     double now_s, next_try_s, connect_start_s, backoff_s;
     gs_lineq q;
     gs_lineq_reader r;
-    uint64_t in, bad, connects;
+    uint64_t connects;
     int last_errno;
 } tcp_client_sink;
 
@@ -423,11 +419,8 @@ static void tc_pump(tcp_client_sink *s)
 static int tc_write_line(void *state, const char *line, size_t len)
 {
     tcp_client_sink *s = state;
-    s->in++;
-    if (len == 0 || line[len - 1] != '\n' || gs_lineq_push(&s->q, line, len) != 0) {
-        s->bad++;
+    if (gs_lineq_take(&s->q, line, len) != 0)
         return -1;
-    }
     tc_pump(s);
     return 0;
 }
@@ -488,11 +481,7 @@ static void tc_info(const void *state, gs_sink_info *o)
     snprintf(o->target, sizeof o->target, "%s", s->target);
     o->state = s->st;
     o->last_errno = s->last_errno;
-    o->c.lines_in = s->in;
-    o->c.lines_sent = s->r.sent;
-    o->c.lines_dropped = s->r.dropped + gs_lineq_reader_lost(&s->r, &s->q) + s->bad;
-    o->c.bytes_sent = s->r.bytes;
-    o->c.lines_queued = gs_lineq_reader_pending(&s->r, &s->q);
+    gs_sink_counters_fill(&o->c, &s->q, &s->r);
     o->c.reopens = s->connects;
 }
 

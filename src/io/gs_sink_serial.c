@@ -17,7 +17,7 @@ typedef struct {
     int fd;
     gs_lineq q;
     gs_lineq_reader r;
-    uint64_t in, bad, reopens; /* bad: lines refused (no newline, too long) */
+    uint64_t reopens;
     int last_errno;
     double now_s, next_open_s;
 } serial_sink;
@@ -113,11 +113,8 @@ static void pump(serial_sink *s)
 static int serial_write_line(void *state, const char *line, size_t len)
 {
     serial_sink *s = state;
-    s->in++;
-    if (len == 0 || line[len - 1] != '\n' || gs_lineq_push(&s->q, line, len) != 0) {
-        s->bad++;
+    if (gs_lineq_take(&s->q, line, len) != 0)
         return -1;
-    }
     pump(s);
     return 0;
 }
@@ -155,11 +152,7 @@ static void serial_info(const void *state, gs_sink_info *o)
     snprintf(o->target, sizeof o->target, "%s@%u", s->cfg.device, (unsigned)s->cfg.baud);
     o->state = s->fd >= 0 ? GS_SINK_UP : GS_SINK_RETRYING;
     o->last_errno = s->last_errno;
-    o->c.lines_in = s->in;
-    o->c.lines_sent = s->r.sent;
-    o->c.lines_dropped = s->r.dropped + gs_lineq_reader_lost(&s->r, &s->q) + s->bad;
-    o->c.bytes_sent = s->r.bytes;
-    o->c.lines_queued = gs_lineq_reader_pending(&s->r, &s->q);
+    gs_sink_counters_fill(&o->c, &s->q, &s->r);
     o->c.reopens = s->reopens;
 }
 
