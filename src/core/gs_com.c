@@ -19,6 +19,13 @@ enum {
     K_N
 };
 
+/* Limb joints run shoulder, elbow, wrist and hip, knee, ankle two apart; each
+ * left keypoint (odd) is followed by its right one (even). */
+#define NEXT_JOINT 2
+_Static_assert(K_LELB == K_LSHO + NEXT_JOINT && K_LWRI == K_LELB + NEXT_JOINT && K_LKNE == K_LHIP + NEXT_JOINT &&
+               K_LANK == K_LKNE + NEXT_JOINT && K_RSHO == K_LSHO + 1 && K_RANK == K_LANK + 1 && (K_LSHO & 1) &&
+               (K_LHIP & 1), "canonical keypoint order");
+
 #if GS_WITH_POSE
 /* BlazePose-33 index of each canonical keypoint (eye = the eye centre, 2/5). */
 static const uint8_t k_blaze_index[K_N] = {
@@ -128,24 +135,12 @@ static vec2 v_mid(vec2 a, vec2 b) { return (vec2){ 0.5f * (a.x + b.x), 0.5f * (a
 static vec2 v_lerp(vec2 a, vec2 b, float t) { return (vec2){ a.x + t * (b.x - a.x), a.y + t * (b.y - a.y) }; }
 static float v_dot(vec2 a, vec2 b) { return a.x * b.x + a.y * b.y; }
 static float v_len(vec2 a) { return sqrtf(a.x * a.x + a.y * a.y); }
-static float v_dist(vec2 a, vec2 b) { return v_len(v_sub(a, b)); }
 
 /* acos in degrees of a cosine clamped to [-1, 1] (rounding may step outside). */
-static float acos_deg(float cs)
+static __attribute__((noinline)) float acos_deg(float cs)
 {
     cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
     return GS_ACOSF(cs) * RAD_TO_DEG;
-}
-
-/* Angle at b between b->a and b->c in degrees, NaN when a leg has no length. */
-static float angle_deg(vec2 a, vec2 b, vec2 c)
-{
-    vec2 u = v_sub(a, b), v = v_sub(c, b);
-    float lu = v_len(u), lv = v_len(v);
-    if (!(lu > 0.0f) || !(lv > 0.0f)) {
-        return NAN;
-    }
-    return acos_deg(v_dot(u, v) / (lu * lv));
 }
 
 /* 0 at x0, 1 at x1 (either order), linear and clamped between. */
@@ -170,20 +165,38 @@ typedef struct {
     vec2 p[K_N];
 } frame;
 
+/* Keypoint a minus keypoint b (one copy: the helpers below take keypoint indices). */
+static __attribute__((noinline)) vec2 kp_diff(const frame *f, int a, int b)
+{
+    return v_sub(f->p[a], f->p[b]);
+}
+
+static float kp_dist(const frame *f, int a, int b)
+{
+    return v_len(kp_diff(f, a, b));
+}
+
+/* Angle at keypoint b between b->a and b->c in degrees, NaN when a leg has no length. */
+static float angle_deg(const frame *f, int a, int b, int c)
+{
+    vec2 u = kp_diff(f, a, b), v = kp_diff(f, c, b);
+    float lu = v_len(u), lv = v_len(v);
+    if (!(lu > 0.0f) || !(lv > 0.0f)) {
+        return NAN;
+    }
+    return acos_deg(v_dot(u, v) / (lu * lv));
+}
+
 static bool all_in(uint32_t set, uint32_t bits)
 {
     return (set & bits) == bits;
 }
 
-/* Mark the observed ones of some keypoints as entering the COM. */
-static void use(frame *f, uint32_t bits)
+/* One segment's COM enters with its full mass; w counts a rebuilt segment at half.
+ * The observed ones of the keypoints in bits count for the confidence. */
+static void add_segment(frame *f, float mass, vec2 p, bool rebuilt, uint32_t bits)
 {
     f->used |= f->obs & bits;
-}
-
-/* One segment's COM enters with its full mass; w counts a rebuilt segment at half. */
-static void add_segment(frame *f, float mass, vec2 p, bool rebuilt)
-{
     f->sx += mass * p.x;
     f->sy += mass * p.y;
     f->m_sum += mass;
@@ -221,21 +234,19 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
 }
 
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
- * the two pairs are roughly parallel, so this also holds in lateral views. */
-static void rebuild_trunk_corner(frame *f, int l, int r, int ol, int or_, float scale)
+ * the two pairs are roughly parallel, so this also holds in lateral views.
+ * l and ol are the left keypoints of the pair and of the other pair (right = left + 1). */
+static void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
 {
-    bool has_l = f->obs & BIT(l), has_r = f->obs & BIT(r);
-    if (has_l == has_r || !all_in(f->obs, BIT2(ol, or_))) {
+    uint32_t seen = f->obs & BIT2(l, l + 1);
+    if (seen == 0 || seen == BIT2(l, l + 1) || !all_in(f->obs, BIT2(ol, ol + 1))) {
         return;
     }
-    vec2 across = v_scale(v_sub(f->p[or_], f->p[ol]), scale); /* left -> right */
-    if (has_l) {
-        f->p[r] = v_add(f->p[l], across);
-        f->have |= BIT(r);
-    } else {
-        f->p[l] = v_sub(f->p[r], across);
-        f->have |= BIT(l);
-    }
+    int known = seen == BIT(l) ? l : l + 1, lost = 2 * l + 1 - known;
+    /* the other pair's left -> right vector, backwards from a right corner */
+    vec2 across = v_scale(kp_diff(f, ol + 1, ol), known == l ? scale : -scale);
+    f->p[lost] = v_add(f->p[known], across);
+    f->have |= BIT(lost);
 }
 
 /* Centre of a left/right pair among the keypoints in set: the mean, or the lone
@@ -258,12 +269,13 @@ static bool pair_centre(const frame *f, uint32_t set, int l, int r, vec2 *out)
  * reflection about the trunk axis (across = -1); seen from the side both sides
  * project onto one plane and the vector is copied (across = +1); oblique views
  * blend the across-axis part linearly. */
-static void mirror_joint(frame *f, int prox, int dist, int oprox, int odist, vec2 axis, float across)
+static void mirror_joint(frame *f, int prox, vec2 axis, float across)
 {
+    int dist = prox + NEXT_JOINT, oprox = ((prox - 1) ^ 1) + 1 /* left <-> right */, odist = oprox + NEXT_JOINT;
     if ((f->have & BIT(dist)) || !(f->have & BIT(prox)) || !all_in(f->obs, BIT2(oprox, odist))) {
         return;
     }
-    vec2 v = v_sub(f->p[odist], f->p[oprox]);
+    vec2 v = kp_diff(f, odist, oprox);
     vec2 along = v_scale(axis, v_dot(v, axis));
     v = v_add(along, v_scale(v_sub(v, along), across));
     f->p[dist] = v_add(f->p[prox], v);
@@ -271,59 +283,50 @@ static void mirror_joint(frame *f, int prox, int dist, int oprox, int odist, vec
 }
 
 /* Head centre from the ears, else a lone ear moved to the mid-line, else the
- * eyes, else the nose; *rebuilt when it is not the ears' own centre. */
-static bool head_centre(frame *f, vec2 *out, bool *rebuilt)
+ * eyes, else the nose; *rebuilt when it is not the ears' own centre. Returns the
+ * keypoints used, 0 when there is no head. */
+static uint32_t head_centre(const frame *f, vec2 *out, bool *rebuilt)
 {
     const uint32_t eyes = BIT2(K_LEYE, K_REYE);
     uint32_t ears = f->obs & BIT2(K_LEAR, K_REAR);
     *rebuilt = true; /* eyes and nose sit in front of the head's centre */
     if (ears) {
         pair_centre(f, ears, K_LEAR, K_REAR, out);
-        use(f, ears);
-        *rebuilt = false;
         if (ears != BIT2(K_LEAR, K_REAR) && all_in(f->obs, eyes)) {
             /* shift the lone ear towards the mid-line by the eyes' half spread, scaled to ear breadth */
             int eye = ears == BIT(K_LEAR) ? K_LEYE : K_REYE;
             vec2 half = v_sub(v_mid(f->p[K_LEYE], f->p[K_REYE]), f->p[eye]);
             *out = v_add(*out, v_scale(half, EARS_OVER_EYES_HALF));
-            use(f, eyes);
-            *rebuilt = true;
+            return ears | eyes;
         }
-        return true;
+        *rebuilt = false;
+        return ears;
     }
     if (pair_centre(f, f->obs, K_LEYE, K_REYE, out)) {
-        use(f, eyes);
-        return true;
+        return eyes;
     }
-    if (f->obs & BIT(K_NOSE)) {
-        use(f, BIT(K_NOSE));
-        *out = f->p[K_NOSE];
-        return true;
-    }
-    return false;
+    *out = f->p[K_NOSE];
+    return f->obs & BIT(K_NOSE);
 }
 
-/* Limb segments in the order their COMs are summed: proximal and distal joint;
- * hand and foot take their extremity keypoints from the distal joint. */
+/* Limb segments in the order their COMs are summed, by proximal joint (the
+ * distal one is the next joint); hand and foot lie beyond the distal joint. */
 typedef struct {
-    uint8_t prox, dist, seg;
+    uint8_t prox, seg;
 } seg_def;
 
 static const seg_def k_limb_segs[] = {
-    { K_LSHO, K_LELB, GS_SEG_UPPER_ARM }, { K_LELB, K_LWRI, GS_SEG_FOREARM },
-    { K_RSHO, K_RELB, GS_SEG_UPPER_ARM }, { K_RELB, K_RWRI, GS_SEG_FOREARM },
-    { K_LELB, K_LWRI, GS_SEG_HAND },      { K_RELB, K_RWRI, GS_SEG_HAND },
-    { K_LHIP, K_LKNE, GS_SEG_THIGH },     { K_LKNE, K_LANK, GS_SEG_SHANK },
-    { K_RHIP, K_RKNE, GS_SEG_THIGH },     { K_RKNE, K_RANK, GS_SEG_SHANK },
-    { K_LKNE, K_LANK, GS_SEG_FOOT },      { K_RKNE, K_RANK, GS_SEG_FOOT },
+    { K_LSHO, GS_SEG_UPPER_ARM }, { K_LELB, GS_SEG_FOREARM }, { K_RSHO, GS_SEG_UPPER_ARM },
+    { K_RELB, GS_SEG_FOREARM },   { K_LELB, GS_SEG_HAND },    { K_RELB, GS_SEG_HAND },
+    { K_LHIP, GS_SEG_THIGH },     { K_LKNE, GS_SEG_SHANK },   { K_RHIP, GS_SEG_THIGH },
+    { K_RKNE, GS_SEG_SHANK },     { K_LKNE, GS_SEG_FOOT },    { K_RKNE, GS_SEG_FOOT },
 };
 
 /* Arm or leg segment between two joints, its COM at fraction c from prox. */
 static void add_bone(frame *f, int prox, int dist, float m, float c)
 {
     if (all_in(f->have, BIT2(prox, dist))) {
-        add_segment(f, m, v_lerp(f->p[prox], f->p[dist], c), is_rebuilt(f, prox, dist));
-        use(f, BIT2(prox, dist));
+        add_segment(f, m, v_lerp(f->p[prox], f->p[dist], c), is_rebuilt(f, prox, dist), BIT2(prox, dist));
     }
 }
 
@@ -367,11 +370,10 @@ static void add_extremity(frame *f, int prox, int dist, bool hand, float m, floa
         rebuilt = !(f->obs & BIT(dist));
     } else if (f->have & BIT(prox)) {
         float e = hand ? c : FOOT_BELOW_ANKLE;
-        com = v_add(q, v_scale(v_sub(q, f->p[prox]), e));
+        com = v_add(q, v_scale(kp_diff(f, dist, prox), e));
         rebuilt = is_rebuilt(f, prox, dist);
     }
-    use(f, bits | BIT(dist));
-    add_segment(f, m, com, rebuilt);
+    add_segment(f, m, com, rebuilt, bits | BIT(dist));
 }
 
 static void add_limbs(frame *f, const seg_table *tb)
@@ -380,9 +382,9 @@ static void add_limbs(frame *f, const seg_table *tb)
         const seg_def *d = &k_limb_segs[i];
         float m = tb->mass_pct[d->seg], c = tb->c[d->seg];
         if (d->seg == GS_SEG_HAND || d->seg == GS_SEG_FOOT) {
-            add_extremity(f, d->prox, d->dist, d->seg == GS_SEG_HAND, m, c);
+            add_extremity(f, d->prox, d->prox + NEXT_JOINT, d->seg == GS_SEG_HAND, m, c);
         } else {
-            add_bone(f, d->prox, d->dist, m, c);
+            add_bone(f, d->prox, d->prox + NEXT_JOINT, m, c);
         }
     }
 }
@@ -451,7 +453,7 @@ static float nose_ankle_stature(const frame *f)
     if (!(f->obs & BIT(K_NOSE)) || !pair_centre(f, f->obs, K_LANK, K_RANK, &a)) {
         return NAN;
     }
-    return NOSE_ANKLE_FACTOR * v_dist(f->p[K_NOSE], a);
+    return NOSE_ANKLE_FACTOR * v_len(v_sub(f->p[K_NOSE], a));
 }
 
 /* ---- uprightness --------------------------------------------------------------- */
@@ -464,22 +466,22 @@ static float min_nan(float acc, float v)
     return (isnan(acc) || v < acc) ? v : acc;
 }
 
+
 /* trunk = shoulder centre - hip centre, trunk_len its length (0 without a trunk). */
 static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axis_from_body, vec2 up)
 {
     float knee = NAN, other = NAN;
     for (int i = 0; i < 2; i++) { /* the right keypoint follows the left one */
         int sh = K_LSHO + i, hp = K_LHIP + i, kn = K_LKNE + i, an = K_LANK + i;
-        const vec2 *p = f->p;
-        if (!all_in(f->obs, BIT(hp) | BIT(kn) | BIT(an))) {
+        if (!all_in(f->obs >> i, BIT(K_LHIP) | BIT(K_LKNE) | BIT(K_LANK))) {
             continue;
         }
-        knee = min_nan(knee, ramp(angle_deg(p[hp], p[kn], p[an]), KNEE_DEG_0, KNEE_DEG_1));
-        if (f->obs & BIT(sh)) {
-            other = min_nan(other, ramp(angle_deg(p[sh], p[hp], p[kn]), HIP_DEG_0, HIP_DEG_1));
+        knee = min_nan(knee, ramp(angle_deg(f, hp, kn, an), KNEE_DEG_0, KNEE_DEG_1));
+        if ((f->obs >> i) & BIT(K_LSHO)) {
+            other = min_nan(other, ramp(angle_deg(f, sh, hp, kn), HIP_DEG_0, HIP_DEG_1));
         }
         if (trunk_len > 0.0f) {
-            float leg = v_dist(p[hp], p[kn]) + v_dist(p[kn], p[an]);
+            float leg = kp_dist(f, hp, kn) + kp_dist(f, kn, an);
             other = min_nan(other, ramp(leg / trunk_len, LEG_TRUNK_0, LEG_TRUNK_1));
         }
     }
@@ -499,19 +501,15 @@ static void mirror_limbs(frame *f, vec2 axis, float trunk_len)
     /* shoulder width / trunk length: ~0.7 frontal, ~0 lateral; else from the hips */
     float width = NAN;
     if (all_in(f->obs, BIT2(K_LSHO, K_RSHO))) {
-        width = v_dist(f->p[K_LSHO], f->p[K_RSHO]) / trunk_len;
+        width = kp_dist(f, K_LSHO, K_RSHO) / trunk_len;
     } else if (all_in(f->obs, BIT2(K_LHIP, K_RHIP))) {
-        width = SHOULDER_OVER_HIP_WIDTH * v_dist(f->p[K_LHIP], f->p[K_RHIP]) / trunk_len;
+        width = SHOULDER_OVER_HIP_WIDTH * kp_dist(f, K_LHIP, K_RHIP) / trunk_len;
     }
     /* no pair seen: one side hidden, i.e. a lateral view */
     float across = isnan(width) ? 1.0f : 1.0f - 2.0f * ramp(width, LATERAL_MAX_WIDTH, MIRROR_MIN_WIDTH);
-    static const uint8_t chain[4][3] = {
-        { K_LSHO, K_LELB, K_LWRI }, { K_RSHO, K_RELB, K_RWRI },
-        { K_LHIP, K_LKNE, K_LANK }, { K_RHIP, K_RKNE, K_RANK } };
-    for (int c = 0; c < 4; c++) {
-        const uint8_t *own = chain[c], *oth = chain[c ^ 1];
-        mirror_joint(f, own[0], own[1], oth[0], oth[1], axis, across);
-        mirror_joint(f, own[1], own[2], oth[1], oth[2], axis, across);
+    static const uint8_t prox[8] = { K_LSHO, K_LELB, K_RSHO, K_RELB, K_LHIP, K_LKNE, K_RHIP, K_RKNE };
+    for (int i = 0; i < 8; i++) {
+        mirror_joint(f, prox[i], axis, across);
     }
 }
 
@@ -604,8 +602,8 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     }
 
     /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
-    rebuild_trunk_corner(&f, K_LSHO, K_RSHO, K_LHIP, K_RHIP, SHOULDER_OVER_HIP_WIDTH);
-    rebuild_trunk_corner(&f, K_LHIP, K_RHIP, K_LSHO, K_RSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
+    rebuild_trunk_corner(&f, K_LSHO, K_LHIP, SHOULDER_OVER_HIP_WIDTH);
+    rebuild_trunk_corner(&f, K_LHIP, K_LSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
     vec2 s = { NAN, NAN }, p = { NAN, NAN };
     bool have_trunk = pair_centre(&f, f.have, K_LSHO, K_RSHO, &s) && pair_centre(&f, f.have, K_LHIP, K_RHIP, &p);
     vec2 trunk = v_sub(s, p), axis = { NAN, NAN };
@@ -633,11 +631,11 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
 
     vec2 hc = { 0.0f, 0.0f };
     bool head_rebuilt;
-    if (head_centre(&f, &hc, &head_rebuilt)) {
-        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, head_rebuilt);
+    uint32_t head_bits = head_centre(&f, &hc, &head_rebuilt);
+    if (head_bits) {
+        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, head_rebuilt, head_bits);
     }
-    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], v_lerp(s, p, tb->c[GS_SEG_TRUNK]), trunk_rebuilt);
-    use(&f, corners);
+    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], v_lerp(s, p, tb->c[GS_SEG_TRUNK]), trunk_rebuilt, corners);
     add_limbs(&f, tb);
     com_result(&f, table_total_pct(tb), out);
 }
