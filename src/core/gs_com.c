@@ -2,6 +2,7 @@
  * and an uprightness score from one frame of 2D keypoints (COCO-17 or
  * BlazePose-33). Segment model and landmark ratios: docs/anthropometry.md.
  * Plain C11, no heap, no stdio; float arithmetic for a Cortex-M4 FPU. */
+#include <float.h>
 #include <math.h>
 
 #include "gravscale/gs_com.h"
@@ -23,8 +24,9 @@ enum {
  * left keypoint (odd) is followed by its right one (even). */
 #define NEXT_JOINT 2
 _Static_assert(K_LELB == K_LSHO + NEXT_JOINT && K_LWRI == K_LELB + NEXT_JOINT && K_LKNE == K_LHIP + NEXT_JOINT &&
-               K_LANK == K_LKNE + NEXT_JOINT && K_RSHO == K_LSHO + 1 && K_RANK == K_LANK + 1 && (K_LSHO & 1) &&
-               (K_LHIP & 1), "canonical keypoint order");
+               K_LANK == K_LKNE + NEXT_JOINT && K_REYE == K_LEYE + 1 && K_REAR == K_LEAR + 1 &&
+               K_RSHO == K_LSHO + 1 && K_RHIP == K_LHIP + 1 && K_RANK == K_LANK + 1 && (K_LSHO & 1) && (K_LHIP & 1),
+               "canonical keypoint order");
 
 #if GS_WITH_POSE
 /* BlazePose-33 index of each canonical keypoint (eye = the eye centre, 2/5). */
@@ -113,7 +115,7 @@ static const seg_table k_tables[3] = {
  * (c == 0 is missing even with min_conf 0). */
 static bool kp_usable(const gs_kp *q, float min_conf)
 {
-    return isfinite(q->c) && q->c > 0.0f && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px);
+    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px);
 }
 
 static float conf01(float c)
@@ -249,19 +251,25 @@ static void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
     f->have |= BIT(lost);
 }
 
-/* Centre of a left/right pair among the keypoints in set: the mean, or the lone
- * point (lateral view). */
-static bool pair_centre(const frame *f, uint32_t set, int l, int r, vec2 *out)
+/* Centre of two keypoints among those in set: the mean, or the lone one. */
+static bool centre_of(const frame *f, uint32_t set, int a, int b, vec2 *out)
 {
-    if (all_in(set, BIT2(l, r))) {
-        *out = v_mid(f->p[l], f->p[r]);
+    if (all_in(set, BIT2(a, b))) {
+        *out = v_mid(f->p[a], f->p[b]);
         return true;
     }
-    if (set & BIT2(l, r)) {
-        *out = f->p[(set & BIT(l)) ? l : r];
+    if (set & BIT2(a, b)) {
+        *out = f->p[(set & BIT(a)) ? a : b];
         return true;
     }
     return false;
+}
+
+/* Centre of the left/right pair from l (the right one follows): a lone point
+ * stands for the pair in a lateral view. */
+static bool pair_centre(const frame *f, uint32_t set, int l, vec2 *out)
+{
+    return centre_of(f, set, l, l + 1, out);
 }
 
 /* Missing distal joint = own proximal joint + the other side's limb vector
@@ -291,7 +299,7 @@ static uint32_t head_centre(const frame *f, vec2 *out, bool *rebuilt)
     uint32_t ears = f->obs & BIT2(K_LEAR, K_REAR);
     *rebuilt = true; /* eyes and nose sit in front of the head's centre */
     if (ears) {
-        pair_centre(f, ears, K_LEAR, K_REAR, out);
+        pair_centre(f, ears, K_LEAR, out);
         if (ears != BIT2(K_LEAR, K_REAR) && all_in(f->obs, eyes)) {
             /* shift the lone ear towards the mid-line by the eyes' half spread, scaled to ear breadth */
             int eye = ears == BIT(K_LEAR) ? K_LEYE : K_REYE;
@@ -302,7 +310,7 @@ static uint32_t head_centre(const frame *f, vec2 *out, bool *rebuilt)
         *rebuilt = false;
         return ears;
     }
-    if (pair_centre(f, f->obs, K_LEYE, K_REYE, out)) {
+    if (pair_centre(f, f->obs, K_LEYE, out)) {
         return eyes;
     }
     *out = f->p[K_NOSE];
@@ -322,15 +330,7 @@ static const seg_def k_limb_segs[] = {
     { K_RKNE, GS_SEG_SHANK },     { K_LKNE, GS_SEG_FOOT },    { K_RKNE, GS_SEG_FOOT },
 };
 
-/* Arm or leg segment between two joints, its COM at fraction c from prox. */
-static void add_bone(frame *f, int prox, int dist, float m, float c)
-{
-    if (all_in(f->have, BIT2(prox, dist))) {
-        add_segment(f, m, v_lerp(f->p[prox], f->p[dist], c), is_rebuilt(f, prox, dist), BIT2(prox, dist));
-    }
-}
-
-/* BlazePose hand or foot from its own keypoints; false when they are missing. */
+/* BlazePose hand or foot from its own keypoints (added to bits); false when they are missing. */
 static bool blaze_extremity(frame *f, int dist, bool hand, float c, vec2 *com, uint32_t *bits)
 {
     vec2 q = f->p[dist];
@@ -338,11 +338,11 @@ static bool blaze_extremity(frame *f, int dist, bool hand, float c, vec2 *com, u
         /* BlazePose pinky and index knuckles lie 12 and 14 after the wrist */
         int pinky = dist + (K_LPINKY - K_LWRI), index = dist + (K_LINDEX - K_LWRI);
         vec2 mcp;
-        if (!pair_centre(f, f->obs, pinky, index, &mcp)) {
+        if (!centre_of(f, f->obs, pinky, index, &mcp)) {
             return false;
         }
         *com = v_lerp(q, mcp, c / WRIST_MCP_OVER_FOREARM);
-        *bits = BIT2(pinky, index);
+        *bits |= BIT2(pinky, index);
         return true;
     }
     /* heel and toe tip lie 2 and 4 after the ankle */
@@ -352,40 +352,40 @@ static bool blaze_extremity(frame *f, int dist, bool hand, float c, vec2 *com, u
     }
     /* halfway between the ankle and the sole point at c: foot COM is ~3 cm above the floor */
     *com = v_mid(q, v_lerp(f->p[heel], f->p[toe], c));
-    *bits = BIT2(heel, toe);
+    *bits |= BIT2(heel, toe);
     return true;
 }
 
-/* Hand or foot beyond the distal joint (wrist/ankle): from the BlazePose
- * extremity keypoints, else along the forearm/shank, else the joint itself. */
-static void add_extremity(frame *f, int prox, int dist, bool hand, float m, float c)
+/* One limb segment: an arm or leg bone between its joints, or a hand or foot
+ * beyond the distal joint (wrist/ankle), from the BlazePose extremity keypoints,
+ * else along the forearm/shank, else at the joint itself. */
+static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
 {
-    if (!(f->have & BIT(dist))) {
+    int prox = d->prox, dist = prox + NEXT_JOINT;
+    bool hand = d->seg == GS_SEG_HAND, extremity = hand || d->seg == GS_SEG_FOOT;
+    bool has_prox = f->have & BIT(prox);
+    if (!(f->have & BIT(dist)) || (!extremity && !has_prox)) {
         return;
     }
     vec2 q = f->p[dist], com = q;
-    uint32_t bits = 0;
-    bool rebuilt = true;
-    if (GS_WITH_BLAZEPOSE33 && f->blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
+    uint32_t bits = BIT(dist);
+    bool rebuilt = is_rebuilt(f, prox, dist); /* also when prox is missing */
+    if (!extremity) {
+        com = v_lerp(f->p[prox], q, c);
+        bits |= BIT(prox);
+    } else if (GS_WITH_BLAZEPOSE33 && f->blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
         rebuilt = !(f->obs & BIT(dist));
-    } else if (f->have & BIT(prox)) {
-        float e = hand ? c : FOOT_BELOW_ANKLE;
-        com = v_add(q, v_scale(kp_diff(f, dist, prox), e));
-        rebuilt = is_rebuilt(f, prox, dist);
+    } else if (has_prox) {
+        com = v_add(q, v_scale(kp_diff(f, dist, prox), hand ? c : FOOT_BELOW_ANKLE));
     }
-    add_segment(f, m, com, rebuilt, bits | BIT(dist));
+    add_segment(f, m, com, rebuilt, bits);
 }
 
 static void add_limbs(frame *f, const seg_table *tb)
 {
     for (size_t i = 0; i < sizeof k_limb_segs / sizeof k_limb_segs[0]; i++) {
         const seg_def *d = &k_limb_segs[i];
-        float m = tb->mass_pct[d->seg], c = tb->c[d->seg];
-        if (d->seg == GS_SEG_HAND || d->seg == GS_SEG_FOOT) {
-            add_extremity(f, d->prox, d->prox + NEXT_JOINT, d->seg == GS_SEG_HAND, m, c);
-        } else {
-            add_bone(f, d->prox, d->prox + NEXT_JOINT, m, c);
-        }
+        add_limb_segment(f, d, tb->mass_pct[d->seg], tb->c[d->seg]);
     }
 }
 
@@ -432,10 +432,10 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
     /* Axis along the posture plumb line ear -> ankle when seen: eyes, nose and
      * toes sit in front of it and would tilt it forward in a lateral view. */
     vec2 ha = hc, fa = fc;
-    if (!pair_centre(f, f->have, K_LEAR, K_REAR, &ha)) {
-        pair_centre(f, f->have, K_LEYE, K_REYE, &ha);
+    if (!pair_centre(f, f->have, K_LEAR, &ha)) {
+        pair_centre(f, f->have, K_LEYE, &ha);
     }
-    pair_centre(f, f->have, K_LANK, K_RANK, &fa);
+    pair_centre(f, f->have, K_LANK, &fa);
     vec2 d = v_sub(ha, fa);
     float len = v_len(d);
     if (!(len > 0.0f)) {
@@ -450,7 +450,7 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 static float nose_ankle_stature(const frame *f)
 {
     vec2 a;
-    if (!(f->obs & BIT(K_NOSE)) || !pair_centre(f, f->obs, K_LANK, K_RANK, &a)) {
+    if (!(f->obs & BIT(K_NOSE)) || !pair_centre(f, f->obs, K_LANK, &a)) {
         return NAN;
     }
     return NOSE_ANKLE_FACTOR * v_len(v_sub(f->p[K_NOSE], a));
@@ -604,10 +604,13 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
     rebuild_trunk_corner(&f, K_LSHO, K_LHIP, SHOULDER_OVER_HIP_WIDTH);
     rebuild_trunk_corner(&f, K_LHIP, K_LSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
-    vec2 s = { NAN, NAN }, p = { NAN, NAN };
-    bool have_trunk = pair_centre(&f, f.have, K_LSHO, K_RSHO, &s) && pair_centre(&f, f.have, K_LHIP, K_RHIP, &p);
-    vec2 trunk = v_sub(s, p), axis = { NAN, NAN };
-    float trunk_len = have_trunk ? v_len(trunk) : 0.0f;
+    vec2 s = { NAN, NAN }, p = { NAN, NAN }, trunk = { 0.0f, 0.0f }, axis = { NAN, NAN };
+    bool have_trunk = pair_centre(&f, f.have, K_LSHO, &s) && pair_centre(&f, f.have, K_LHIP, &p);
+    float trunk_len = 0.0f;
+    if (have_trunk) {
+        trunk = v_sub(s, p);
+        trunk_len = v_len(trunk);
+    }
     if (trunk_len > 0.0f) {
         axis = v_scale(trunk, 1.0f / trunk_len);
         if (!axis_from_body) {
