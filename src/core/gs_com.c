@@ -7,6 +7,9 @@
 
 #include "gravscale/gs_com.h"
 
+/* one copy of a helper called from several places: smaller code on the Cortex-M4 */
+#define NOINLINE __attribute__((noinline))
+
 #define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
 
 /* ---- canonical keypoints (COCO-17 order first, BlazePose extras after) ---- */
@@ -139,17 +142,35 @@ static float v_dot(vec2 a, vec2 b) { return a.x * b.x + a.y * b.y; }
 static float v_len(vec2 a) { return sqrtf(a.x * a.x + a.y * a.y); }
 
 /* acos in degrees of a cosine clamped to [-1, 1] (rounding may step outside). */
-static __attribute__((noinline)) float acos_deg(float cs)
+static NOINLINE float acos_deg(float cs)
 {
     cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
     return GS_ACOSF(cs) * RAD_TO_DEG;
 }
 
 /* 0 at x0, 1 at x1 (either order), linear and clamped between. */
-static __attribute__((noinline)) float ramp(float x, float x0, float x1)
+static NOINLINE float ramp(float x, float x0, float x1)
 {
     float t = (x - x0) / (x1 - x0);
     return t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+}
+
+/* Weighted sums: total weight, weighted x and y, and one more weighted quantity e. */
+typedef struct {
+    float w, x, y, e;
+} wsum;
+
+static NOINLINE void wsum_add(wsum *s, float w, vec2 p, float e)
+{
+    s->w += w;
+    s->x += w * p.x;
+    s->y += w * p.y;
+    s->e += w * e;
+}
+
+static vec2 wsum_mean(const wsum *s)
+{
+    return (vec2){ s->x / s->w, s->y / s->w };
 }
 
 /* ---- per-frame working state --------------------------------------------------- */
@@ -161,16 +182,22 @@ typedef struct {
     uint32_t obs;  /* bit k: keypoint k detected with enough confidence */
     uint32_t have; /* bit k: observed or rebuilt */
     uint32_t used; /* bit k: observed keypoint k entered the COM */
-    float m_sum, m_obs, sx, sy;
+    wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
     bool blaze; /* BlazePose-33 input: hands and feet have extra keypoints */
     float c[K_N];
     vec2 p[K_N];
 } frame;
 
-/* Keypoint a minus keypoint b (one copy: the helpers below take keypoint indices). */
-static __attribute__((noinline)) vec2 kp_diff(const frame *f, int a, int b)
+/* Keypoint a minus keypoint b: the helpers below take keypoint indices (smaller calls). */
+static vec2 kp_diff(const frame *f, int a, int b)
 {
     return v_sub(f->p[a], f->p[b]);
+}
+
+/* Keypoint base + s x (keypoint a - keypoint b). */
+static vec2 kp_extend(const frame *f, int base, int a, int b, float s)
+{
+    return v_add(f->p[base], v_scale(kp_diff(f, a, b), s));
 }
 
 static float kp_dist(const frame *f, int a, int b)
@@ -196,13 +223,10 @@ static bool all_in(uint32_t set, uint32_t bits)
 
 /* One segment's COM enters with its full mass; w counts a rebuilt segment at half.
  * The observed ones of the keypoints in bits count for the confidence. */
-static void add_segment(frame *f, float mass, vec2 p, bool rebuilt, uint32_t bits)
+static NOINLINE void add_segment(frame *f, float mass, vec2 p, bool rebuilt, uint32_t bits)
 {
     f->used |= f->obs & bits;
-    f->sx += mass * p.x;
-    f->sy += mass * p.y;
-    f->m_sum += mass;
-    f->m_obs += rebuilt ? 0.5f * mass : mass;
+    wsum_add(&f->com, mass, p, rebuilt ? 0.5f : 1.0f);
 }
 
 static bool is_rebuilt(const frame *f, int a, int b)
@@ -232,7 +256,7 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
     f->have = f->obs;
     f->blaze = blaze;
     f->used = 0;
-    f->m_sum = f->m_obs = f->sx = f->sy = 0.0f;
+    f->com = (wsum){ 0.0f, 0.0f, 0.0f, 0.0f };
 }
 
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
@@ -246,8 +270,7 @@ static void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
     }
     int known = seen == BIT(l) ? l : l + 1, lost = 2 * l + 1 - known;
     /* the other pair's left -> right vector, backwards from a right corner */
-    vec2 across = v_scale(kp_diff(f, ol + 1, ol), known == l ? scale : -scale);
-    f->p[lost] = v_add(f->p[known], across);
+    f->p[lost] = kp_extend(f, known, ol + 1, ol, known == l ? scale : -scale);
     f->have |= BIT(lost);
 }
 
@@ -376,7 +399,7 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
     } else if (GS_WITH_BLAZEPOSE33 && f->blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
         rebuilt = !(f->obs & BIT(dist));
     } else if (has_prox) {
-        com = v_add(q, v_scale(kp_diff(f, dist, prox), hand ? c : FOOT_BELOW_ANKLE));
+        com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
     }
     add_segment(f, m, com, rebuilt, bits);
 }
@@ -401,34 +424,24 @@ static const uint8_t k_marks[][2] = {
     { K_RHEEL, M_HEEL },   { K_LTOE, M_TOE },     { K_RTOE, M_TOE },
 };
 
-typedef struct {
-    float sw, sx, sy, sf;
-} group;
-
 /* Weighted head and foot landmark centroids with their mean height fractions;
  * stature = their distance along the body axis / the fraction difference.
  * Called before any keypoint is rebuilt (have == obs). */
 static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 {
-    group g[2] = { { 0.0f, 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f } }; /* head, feet */
+    wsum g[2] = { { 0.0f, 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f } }; /* head, feet; e: height fraction */
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
         if (!(f->obs & BIT(k))) {
             continue;
         }
-        group *gr = &g[kind >= M_ANKLE];
-        float w = f->c[k] * k_mark_prior[kind];
-        gr->sw += w;
-        gr->sx += w * f->p[k].x;
-        gr->sy += w * f->p[k].y;
-        gr->sf += w * k_mark_frac[kind];
+        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k], k_mark_frac[kind]);
     }
-    const group *h = &g[0], *ft = &g[1];
-    if (!(h->sw > 0.0f) || !(ft->sw > 0.0f)) {
+    const wsum *h = &g[0], *ft = &g[1];
+    if (!(h->w > 0.0f) || !(ft->w > 0.0f)) {
         return false;
     }
-    vec2 hc = { h->sx / h->sw, h->sy / h->sw };
-    vec2 fc = { ft->sx / ft->sw, ft->sy / ft->sw };
+    vec2 hc = wsum_mean(h), fc = wsum_mean(ft);
     /* Axis along the posture plumb line ear -> ankle when seen: eyes, nose and
      * toes sit in front of it and would tilt it forward in a lateral view. */
     vec2 ha = hc, fa = fc;
@@ -442,7 +455,7 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
         return false;
     }
     *up = v_scale(d, 1.0f / len);
-    *stature_px = v_dot(v_sub(hc, fc), *up) / (h->sf / h->sw - ft->sf / ft->sw);
+    *stature_px = v_dot(v_sub(hc, fc), *up) / (h->e / h->w - ft->e / ft->w);
     return true;
 }
 
@@ -559,8 +572,9 @@ static void out_unknown(gs_com_out *out)
 /* Renormalise over the segments present; w falls with the square of what is missing. */
 static void com_result(const frame *f, float total, gs_com_out *out)
 {
-    out->x_px = f->sx / f->m_sum;
-    out->y_px = f->sy / f->m_sum;
+    vec2 com = wsum_mean(&f->com);
+    out->x_px = com.x;
+    out->y_px = com.y;
     float csum = 0.0f;
     int n = 0;
     for (int k = 0; k < K_N; k++) {
@@ -569,12 +583,12 @@ static void com_result(const frame *f, float total, gs_com_out *out)
             n++;
         }
     }
-    float frac = f->m_obs / total;
+    float frac = f->com.e / total;
     float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
     /* a segment missing outright (not even rebuilt from its mirror, e.g. the head
      * out of the frame at the apex) biases the renormalised COM by centimetres:
      * such frames count only when nothing better exists */
-    if (f->m_sum < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
+    if (f->com.w < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
     out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
     if (!isfinite(out->x_px) || !isfinite(out->y_px)) {
         out->x_px = out->y_px = NAN;
