@@ -114,8 +114,8 @@ static const seg_table k_tables[3] = {
 
 #define RAD_TO_DEG 57.29577951308232f
 
-/* A keypoint counts when its confidence is positive, >= min_conf and all is finite
- * (c == 0 is missing even with min_conf 0). */
+/* A keypoint counts when its confidence is positive, finite and >= min_conf and its
+ * position is finite (c == 0 is missing even with min_conf 0). */
 static bool kp_usable(const gs_kp *q, float min_conf)
 {
     return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px);
@@ -216,6 +216,12 @@ static float angle_deg(const frame *f, int a, int b, int c)
     return acos_deg(v_dot(u, v) / (lu * lv));
 }
 
+/* The same keypoint on the other side of the body (left odd, right even). */
+static int other_side(int k)
+{
+    return ((k - 1) ^ 1) + 1;
+}
+
 static bool all_in(uint32_t set, uint32_t bits)
 {
     return (set & bits) == bits;
@@ -302,7 +308,7 @@ static bool pair_centre(const frame *f, uint32_t set, int l, vec2 *out)
  * blend the across-axis part linearly. */
 static void mirror_joint(frame *f, int prox, vec2 axis, float across)
 {
-    int dist = prox + NEXT_JOINT, oprox = ((prox - 1) ^ 1) + 1 /* left <-> right */, odist = oprox + NEXT_JOINT;
+    int dist = prox + NEXT_JOINT, oprox = other_side(prox), odist = oprox + NEXT_JOINT;
     if ((f->have & BIT(dist)) || !(f->have & BIT(prox)) || !all_in(f->obs, BIT2(oprox, odist))) {
         return;
     }
@@ -354,7 +360,7 @@ static const seg_def k_limb_segs[] = {
 };
 
 /* BlazePose hand or foot from its own keypoints (added to bits); false when they are missing. */
-static bool blaze_extremity(frame *f, int dist, bool hand, float c, vec2 *com, uint32_t *bits)
+static bool blaze_extremity(const frame *f, int dist, bool hand, float c, vec2 *com, uint32_t *bits)
 {
     vec2 q = f->p[dist];
     if (hand) {
@@ -569,12 +575,11 @@ static void out_unknown(gs_com_out *out)
 }
 
 #if GS_WITH_POSE
-/* Renormalise over the segments present; w falls with the square of what is missing. */
+/* Renormalise over the segments present; w falls with the square of what is missing.
+ * A COM out of float range leaves out unknown (NaN, w = 0). */
 static void com_result(const frame *f, float total, gs_com_out *out)
 {
     vec2 com = wsum_mean(&f->com);
-    out->x_px = com.x;
-    out->y_px = com.y;
     float csum = 0.0f;
     int n = 0;
     for (int k = 0; k < K_N; k++) {
@@ -589,10 +594,10 @@ static void com_result(const frame *f, float total, gs_com_out *out)
      * out of the frame at the apex) biases the renormalised COM by centimetres:
      * such frames count only when nothing better exists */
     if (f->com.w < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
-    out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
-    if (!isfinite(out->x_px) || !isfinite(out->y_px)) {
-        out->x_px = out->y_px = NAN;
-        out->w = 0.0f;
+    if (isfinite(com.x) && isfinite(com.y)) {
+        out->x_px = com.x;
+        out->y_px = com.y;
+        out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
     }
 }
 
@@ -609,7 +614,9 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     if (stature == GS_STATURE_NOSE_ANKLE_117) {
         st = nose_ankle_stature(&f);
     }
-    out->stature_px = isfinite(st) ? st : NAN; /* absurd coordinates overflow float */
+    if (isfinite(st)) { /* else NaN: absurd coordinates overflow float */
+        out->stature_px = st;
+    }
     if (!isfinite(up.x) || !isfinite(up.y)) {
         up = (vec2){ NAN, NAN };
         axis_from_body = false;
@@ -618,7 +625,7 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
     rebuild_trunk_corner(&f, K_LSHO, K_LHIP, SHOULDER_OVER_HIP_WIDTH);
     rebuild_trunk_corner(&f, K_LHIP, K_LSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
-    vec2 s = { NAN, NAN }, p = { NAN, NAN }, trunk = { 0.0f, 0.0f }, axis = { NAN, NAN };
+    vec2 s = { NAN, NAN }, p = { NAN, NAN }, trunk = { 0.0f, 0.0f };
     bool have_trunk = pair_centre(&f, f.have, K_LSHO, &s) && pair_centre(&f, f.have, K_LHIP, &p);
     float trunk_len = 0.0f;
     if (have_trunk) {
@@ -626,10 +633,12 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
         trunk_len = v_len(trunk);
     }
     if (trunk_len > 0.0f) {
-        axis = v_scale(trunk, 1.0f / trunk_len);
+        vec2 axis = v_scale(trunk, 1.0f / trunk_len);
         if (!axis_from_body) {
             up = axis; /* fallback axis: hip centre -> shoulder centre */
         }
+        /* lost limb joints from the other side (writes only keypoints not observed) */
+        mirror_limbs(&f, axis, trunk_len);
     }
     if (!isnan(up.x)) {
         out->up_x = up.x;
@@ -642,9 +651,6 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     }
     const uint32_t corners = BIT2(K_LSHO, K_RSHO) | BIT2(K_LHIP, K_RHIP);
     bool trunk_rebuilt = !all_in(f.obs, corners);
-    if (trunk_len > 0.0f) {
-        mirror_limbs(&f, axis, trunk_len);
-    }
 
     vec2 hc = { 0.0f, 0.0f };
     bool head_rebuilt;
