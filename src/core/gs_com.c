@@ -2,9 +2,13 @@
  * and an uprightness score from one frame of 2D keypoints (COCO-17 or
  * BlazePose-33). Segment model and landmark ratios: docs/anthropometry.md.
  * Plain C11, no heap, no stdio; float arithmetic for a Cortex-M4 FPU. */
+#include <float.h>
 #include <math.h>
 
 #include "gravscale/gs_com.h"
+
+/* one copy of a helper called from several places: smaller code on the Cortex-M4 */
+#define NOINLINE __attribute__((noinline))
 
 #define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
 
@@ -18,6 +22,14 @@ enum {
     K_LPINKY, K_RPINKY, K_LINDEX, K_RINDEX, /* BlazePose 17/18 pinky, 19/20 index knuckles */
     K_N
 };
+
+/* Limb joints run shoulder, elbow, wrist and hip, knee, ankle two apart; each
+ * left keypoint (odd) is followed by its right one (even). */
+#define NEXT_JOINT 2
+_Static_assert(K_LELB == K_LSHO + NEXT_JOINT && K_LWRI == K_LELB + NEXT_JOINT && K_LKNE == K_LHIP + NEXT_JOINT &&
+               K_LANK == K_LKNE + NEXT_JOINT && K_REYE == K_LEYE + 1 && K_REAR == K_LEAR + 1 &&
+               K_RSHO == K_LSHO + 1 && K_RHIP == K_LHIP + 1 && K_RANK == K_LANK + 1 && (K_LSHO & 1) && (K_LHIP & 1),
+               "canonical keypoint order");
 
 #if GS_WITH_POSE
 /* BlazePose-33 index of each canonical keypoint (eye = the eye centre, 2/5). */
@@ -34,13 +46,11 @@ static const uint8_t k_blaze_index[K_N] = {
 
 typedef struct {
     float mass_pct[GS_SEG_COUNT]; /* published % of body mass, one side for limbs */
-    float c_trunk;     /* trunk COM from the shoulder centre towards the hip centre */
-    float c_upper_arm; /* from the shoulder */
-    float c_forearm;   /* from the elbow */
-    float c_thigh;     /* from the hip */
-    float c_shank;     /* from the knee */
-    float e_hand;      /* hand COM beyond the wrist, in forearm lengths */
-    float c_foot;      /* foot COM along heel -> toe tip */
+    /* COM position per segment: trunk from the shoulder centre towards the hip
+     * centre; upper arm from the shoulder; forearm from the elbow; hand beyond the
+     * wrist in forearm lengths; thigh from the hip; shank from the knee; foot along
+     * heel -> toe tip. The head's COM is its centre (no fraction). */
+    float c[GS_SEG_COUNT];
 } seg_table;
 
 static const seg_table k_tables[3] = {
@@ -49,21 +59,21 @@ static const seg_table k_tables[3] = {
      * Trunk SUPR->MIDH (0.4486 M, 0.4151 F); hand 0.79/0.747 of WJC->MET3 turned
      * into forearm lengths; foot HEEL->TTIP. Female shank/hand values from memory. */
     { { 6.81f, 43.015f, 2.63f, 1.50f, 0.585f, 14.47f, 4.57f, 1.33f },
-      0.4319f, 0.5763f, 0.4567f, 0.3854f, 0.4438f, 0.24f, 0.4215f },
+      { 0.0f, 0.4319f, 0.5763f, 0.4567f, 0.24f, 0.3854f, 0.4438f, 0.4215f } },
     /* Clauser C.E., McConville J.T., Young J.W. (1969) Weight, volume and centre
      * of mass of segments of the human body. AMRL-TR-69-70, mean of 13 cadavers.
      * Trunk COM 38.0 % of trunk length read from the hip end (see the doc: read
      * from the top it puts the standing COM at 0.60 of stature); hand 18 % of
      * hand length = 0.13 forearm lengths beyond the wrist. */
     { { 7.3f, 50.7f, 2.6f, 1.6f, 0.7f, 10.3f, 4.3f, 1.5f },
-      0.6197f, 0.513f, 0.390f, 0.372f, 0.371f, 0.13f, 0.449f },
+      { 0.0f, 0.6197f, 0.513f, 0.390f, 0.13f, 0.372f, 0.371f, 0.449f } },
     /* Dempster W.T. (1955) Space requirements of the seated operator, WADC-TR-55-159,
      * as tabulated by Winter D.A., Biomechanics and Motor Control of Human Movement,
      * Table 4.1. Head+neck COM at the ear canal; trunk glenohumeral -> trochanter 0.50;
      * hand 0.506 of wrist -> middle-finger knuckle = 0.27 forearm lengths;
      * foot 0.50 of malleolus -> metatarsal II, used as 0.50 heel -> toe. */
     { { 8.1f, 49.7f, 2.8f, 1.6f, 0.6f, 10.0f, 4.65f, 1.45f },
-      0.50f, 0.436f, 0.430f, 0.433f, 0.433f, 0.27f, 0.50f },
+      { 0.0f, 0.50f, 0.436f, 0.430f, 0.27f, 0.433f, 0.433f, 0.50f } },
 };
 
 /* ---- model constants (see docs/anthropometry.md) ---------------------------- */
@@ -104,6 +114,18 @@ static const seg_table k_tables[3] = {
 
 #define RAD_TO_DEG 57.29577951308232f
 
+/* A keypoint counts when its confidence is positive, finite and >= min_conf and its
+ * position is finite (c == 0 is missing even with min_conf 0). */
+static bool kp_usable(const gs_kp *q, float min_conf)
+{
+    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px);
+}
+
+static float conf01(float c)
+{
+    return c > 1.0f ? 1.0f : c;
+}
+
 #if GS_WITH_POSE /* the skeleton model (gs_features.h); a point needs none of it */
 /* ---- small vector helpers ---------------------------------------------------- */
 
@@ -119,116 +141,164 @@ static vec2 v_lerp(vec2 a, vec2 b, float t) { return (vec2){ a.x + t * (b.x - a.
 static float v_dot(vec2 a, vec2 b) { return a.x * b.x + a.y * b.y; }
 static float v_len(vec2 a) { return sqrtf(a.x * a.x + a.y * a.y); }
 
-/* Angle at b between b->a and b->c in degrees, NaN when a leg has no length. */
-static float angle_deg(vec2 a, vec2 b, vec2 c)
+/* acos in degrees of a cosine clamped to [-1, 1] (rounding may step outside). */
+static NOINLINE float acos_deg(float cs)
 {
-    vec2 u = v_sub(a, b), v = v_sub(c, b);
-    float lu = v_len(u), lv = v_len(v);
-    if (!(lu > 0.0f) || !(lv > 0.0f)) {
-        return NAN;
-    }
-    float cs = v_dot(u, v) / (lu * lv);
     cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
     return GS_ACOSF(cs) * RAD_TO_DEG;
 }
 
 /* 0 at x0, 1 at x1 (either order), linear and clamped between. */
-static float ramp(float x, float x0, float x1)
+static NOINLINE float ramp(float x, float x0, float x1)
 {
     float t = (x - x0) / (x1 - x0);
     return t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
 }
 
-/* ---- per-frame working state --------------------------------------------------- */
-
+/* Weighted sums: total weight, weighted x and y, and one more weighted quantity e. */
 typedef struct {
-    vec2 p[K_N];
-    float c[K_N];
-    bool obs[K_N];  /* detected with enough confidence */
-    bool have[K_N]; /* observed or rebuilt */
-    uint32_t used;  /* bit k: observed keypoint k entered the COM */
-    float m_sum, m_obs, sx, sy;
-} frame;
+    float w, x, y, e;
+} wsum;
 
-static void use(frame *f, int k)
+static NOINLINE void wsum_add(wsum *s, float w, vec2 p, float e)
 {
-    if (f->obs[k]) {
-        f->used |= 1u << k;
-    }
+    s->w += w;
+    s->x += w * p.x;
+    s->y += w * p.y;
+    s->e += w * e;
 }
 
-/* One segment's COM enters with its full mass; w counts a rebuilt segment at half. */
-static void add_segment(frame *f, float mass, vec2 p, bool rebuilt)
+static vec2 wsum_mean(const wsum *s)
 {
-    f->sx += mass * p.x;
-    f->sy += mass * p.y;
-    f->m_sum += mass;
-    f->m_obs += rebuilt ? 0.5f * mass : mass;
+    return (vec2){ s->x / s->w, s->y / s->w };
+}
+
+/* ---- per-frame working state --------------------------------------------------- */
+
+#define BIT(k) (1u << (k))
+#define BIT2(a, b) (BIT(a) | BIT(b))
+
+typedef struct {
+    uint32_t obs;  /* bit k: keypoint k detected with enough confidence */
+    uint32_t have; /* bit k: observed or rebuilt */
+    uint32_t used; /* bit k: observed keypoint k entered the COM */
+    wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
+    bool blaze; /* BlazePose-33 input: hands and feet have extra keypoints */
+    float c[K_N];
+    vec2 p[K_N];
+} frame;
+
+/* Keypoint a minus keypoint b: the helpers below take keypoint indices (smaller calls). */
+static vec2 kp_diff(const frame *f, int a, int b)
+{
+    return v_sub(f->p[a], f->p[b]);
+}
+
+/* Keypoint base + s x (keypoint a - keypoint b). */
+static vec2 kp_extend(const frame *f, int base, int a, int b, float s)
+{
+    return v_add(f->p[base], v_scale(kp_diff(f, a, b), s));
+}
+
+static float kp_dist(const frame *f, int a, int b)
+{
+    return v_len(kp_diff(f, a, b));
+}
+
+/* Angle at keypoint b between b->a and b->c in degrees, NaN when a leg has no length. */
+static float angle_deg(const frame *f, int a, int b, int c)
+{
+    vec2 u = kp_diff(f, a, b), v = kp_diff(f, c, b);
+    float lu = v_len(u), lv = v_len(v);
+    if (!(lu > 0.0f) || !(lv > 0.0f)) {
+        return NAN;
+    }
+    return acos_deg(v_dot(u, v) / (lu * lv));
+}
+
+/* The same keypoint on the other side of the body (left odd, right even). */
+static int other_side(int k)
+{
+    return ((k - 1) ^ 1) + 1;
+}
+
+static bool all_in(uint32_t set, uint32_t bits)
+{
+    return (set & bits) == bits;
+}
+
+/* One segment's COM enters with its full mass; w counts a rebuilt segment at half.
+ * The observed ones of the keypoints in bits count for the confidence. */
+static NOINLINE void add_segment(frame *f, float mass, vec2 p, bool rebuilt, uint32_t bits)
+{
+    f->used |= f->obs & bits;
+    wsum_add(&f->com, mass, p, rebuilt ? 0.5f : 1.0f);
 }
 
 static bool is_rebuilt(const frame *f, int a, int b)
 {
-    return !f->obs[a] || !f->obs[b];
+    return !all_in(f->obs, BIT2(a, b));
 }
 
-static void load(frame *f, gs_layout layout, float min_conf, const gs_kp *kp)
+static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
 {
+    f->obs = 0;
     for (int k = 0; k < K_N; k++) {
-        f->obs[k] = false;
-        f->have[k] = false;
         f->c[k] = 0.0f;
         f->p[k] = (vec2){ NAN, NAN };
         int src = -1;
-        if (GS_WITH_COCO17 && (!GS_WITH_BLAZEPOSE33 || layout == GS_LAYOUT_COCO17)) {
+        if (GS_WITH_COCO17 && !blaze) {
             src = k < 17 ? k : -1;
         } else if (GS_WITH_BLAZEPOSE33) {
             src = k_blaze_index[k];
         }
-        if (src < 0) {
-            continue;
-        }
-        const gs_kp *q = &kp[src];
-        /* c == 0 is missing even with min_conf 0; non-finite input is missing too. */
-        if (isfinite(q->c) && q->c > 0.0f && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px)) {
-            f->obs[k] = true;
-            f->have[k] = true;
-            f->c[k] = q->c > 1.0f ? 1.0f : q->c;
+        if (src >= 0 && kp_usable(&kp[src], min_conf)) {
+            const gs_kp *q = &kp[src];
+            f->obs |= BIT(k);
+            f->c[k] = conf01(q->c);
             f->p[k] = (vec2){ q->x_px, q->y_px };
         }
     }
+    f->have = f->obs;
+    f->blaze = blaze;
     f->used = 0;
-    f->m_sum = f->m_obs = f->sx = f->sy = 0.0f;
+    f->com = (wsum){ 0.0f, 0.0f, 0.0f, 0.0f };
 }
 
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
- * the two pairs are roughly parallel, so this also holds in lateral views. */
-static void rebuild_trunk_corner(frame *f, int l, int r, int ol, int or_, float scale)
+ * the two pairs are roughly parallel, so this also holds in lateral views.
+ * l and ol are the left keypoints of the pair and of the other pair (right = left + 1). */
+static void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
 {
-    if (f->obs[l] == f->obs[r] || !f->obs[ol] || !f->obs[or_]) {
+    uint32_t seen = f->obs & BIT2(l, l + 1);
+    if (seen == 0 || seen == BIT2(l, l + 1) || !all_in(f->obs, BIT2(ol, ol + 1))) {
         return;
     }
-    vec2 across = v_scale(v_sub(f->p[or_], f->p[ol]), scale); /* left -> right */
-    if (f->obs[l]) {
-        f->p[r] = v_add(f->p[l], across);
-        f->have[r] = true;
-    } else {
-        f->p[l] = v_sub(f->p[r], across);
-        f->have[l] = true;
-    }
+    int known = seen == BIT(l) ? l : l + 1, lost = 2 * l + 1 - known;
+    /* the other pair's left -> right vector, backwards from a right corner */
+    f->p[lost] = kp_extend(f, known, ol + 1, ol, known == l ? scale : -scale);
+    f->have |= BIT(lost);
 }
 
-/* Centre of a left/right pair: the mean, or the lone point (lateral view). */
-static bool pair_centre(const frame *f, int l, int r, vec2 *out)
+/* Centre of two keypoints among those in set: the mean, or the lone one. */
+static bool centre_of(const frame *f, uint32_t set, int a, int b, vec2 *out)
 {
-    if (f->have[l] && f->have[r]) {
-        *out = v_mid(f->p[l], f->p[r]);
+    if (all_in(set, BIT2(a, b))) {
+        *out = v_mid(f->p[a], f->p[b]);
         return true;
     }
-    if (f->have[l] || f->have[r]) {
-        *out = f->have[l] ? f->p[l] : f->p[r];
+    if (set & BIT2(a, b)) {
+        *out = f->p[(set & BIT(a)) ? a : b];
         return true;
     }
     return false;
+}
+
+/* Centre of the left/right pair from l (the right one follows): a lone point
+ * stands for the pair in a lateral view. */
+static bool pair_centre(const frame *f, uint32_t set, int l, vec2 *out)
+{
+    return centre_of(f, set, l, l + 1, out);
 }
 
 /* Missing distal joint = own proximal joint + the other side's limb vector
@@ -236,178 +306,162 @@ static bool pair_centre(const frame *f, int l, int r, vec2 *out)
  * reflection about the trunk axis (across = -1); seen from the side both sides
  * project onto one plane and the vector is copied (across = +1); oblique views
  * blend the across-axis part linearly. */
-static void mirror_joint(frame *f, int prox, int dist, int oprox, int odist, vec2 axis, float across)
+static void mirror_joint(frame *f, int prox, vec2 axis, float across)
 {
-    if (f->have[dist] || !f->have[prox] || !f->obs[oprox] || !f->obs[odist]) {
+    int dist = prox + NEXT_JOINT, oprox = other_side(prox), odist = oprox + NEXT_JOINT;
+    if ((f->have & BIT(dist)) || !(f->have & BIT(prox)) || !all_in(f->obs, BIT2(oprox, odist))) {
         return;
     }
-    vec2 v = v_sub(f->p[odist], f->p[oprox]);
+    vec2 v = kp_diff(f, odist, oprox);
     vec2 along = v_scale(axis, v_dot(v, axis));
     v = v_add(along, v_scale(v_sub(v, along), across));
     f->p[dist] = v_add(f->p[prox], v);
-    f->have[dist] = true;
+    f->have |= BIT(dist);
 }
 
-static bool head_centre(frame *f, vec2 *out, bool *rebuilt)
+/* Head centre from the ears, else a lone ear moved to the mid-line, else the
+ * eyes, else the nose; *rebuilt when it is not the ears' own centre. Returns the
+ * keypoints used, 0 when there is no head. */
+static uint32_t head_centre(const frame *f, vec2 *out, bool *rebuilt)
 {
-    *rebuilt = false;
-    if (f->obs[K_LEAR] && f->obs[K_REAR]) {
-        use(f, K_LEAR);
-        use(f, K_REAR);
-        *out = v_mid(f->p[K_LEAR], f->p[K_REAR]);
-        return true;
-    }
-    if (f->obs[K_LEAR] || f->obs[K_REAR]) {
-        int ear = f->obs[K_LEAR] ? K_LEAR : K_REAR;
-        int eye = ear == K_LEAR ? K_LEYE : K_REYE;
-        use(f, ear);
-        *out = f->p[ear];
-        if (f->obs[K_LEYE] && f->obs[K_REYE]) {
+    const uint32_t eyes = BIT2(K_LEYE, K_REYE);
+    uint32_t ears = f->obs & BIT2(K_LEAR, K_REAR);
+    *rebuilt = true; /* eyes and nose sit in front of the head's centre */
+    if (ears) {
+        pair_centre(f, ears, K_LEAR, out);
+        if (ears != BIT2(K_LEAR, K_REAR) && all_in(f->obs, eyes)) {
             /* shift the lone ear towards the mid-line by the eyes' half spread, scaled to ear breadth */
+            int eye = ears == BIT(K_LEAR) ? K_LEYE : K_REYE;
             vec2 half = v_sub(v_mid(f->p[K_LEYE], f->p[K_REYE]), f->p[eye]);
             *out = v_add(*out, v_scale(half, EARS_OVER_EYES_HALF));
-            use(f, K_LEYE);
-            use(f, K_REYE);
-            *rebuilt = true;
+            return ears | eyes;
         }
-        return true;
+        *rebuilt = false;
+        return ears;
     }
-    if (f->obs[K_LEYE] || f->obs[K_REYE]) {
-        pair_centre(f, K_LEYE, K_REYE, out);
-        use(f, K_LEYE);
-        use(f, K_REYE);
-        *rebuilt = true; /* eyes sit in front of the head's centre */
-        return true;
+    if (pair_centre(f, f->obs, K_LEYE, out)) {
+        return eyes;
     }
-    if (f->obs[K_NOSE]) {
-        use(f, K_NOSE);
-        *out = f->p[K_NOSE];
-        *rebuilt = true;
-        return true;
-    }
-    return false;
+    *out = f->p[K_NOSE];
+    return f->obs & BIT(K_NOSE);
 }
 
-/* Arm or leg of one side: proximal (shoulder/hip), middle (elbow/knee), distal
- * (wrist/ankle) with segment masses and COM fractions; extremity handled by caller. */
-static void add_limb(frame *f, int j0, int j1, int j2, float m_prox, float c_prox, float m_dist, float c_dist)
-{
-    if (f->have[j0] && f->have[j1]) {
-        add_segment(f, m_prox, v_lerp(f->p[j0], f->p[j1], c_prox), is_rebuilt(f, j0, j1));
-        use(f, j0);
-        use(f, j1);
-    }
-    if (f->have[j1] && f->have[j2]) {
-        add_segment(f, m_dist, v_lerp(f->p[j1], f->p[j2], c_dist), is_rebuilt(f, j1, j2));
-        use(f, j1);
-        use(f, j2);
-    }
-}
+/* Limb segments in the order their COMs are summed, by proximal joint (the
+ * distal one is the next joint); hand and foot lie beyond the distal joint. */
+typedef struct {
+    uint8_t prox, seg;
+} seg_def;
 
-static void add_hand(frame *f, bool blaze, int elb, int wri, int pinky, int index, float m, float e_hand)
+static const seg_def k_limb_segs[] = {
+    { K_LSHO, GS_SEG_UPPER_ARM }, { K_LELB, GS_SEG_FOREARM }, { K_RSHO, GS_SEG_UPPER_ARM },
+    { K_RELB, GS_SEG_FOREARM },   { K_LELB, GS_SEG_HAND },    { K_RELB, GS_SEG_HAND },
+    { K_LHIP, GS_SEG_THIGH },     { K_LKNE, GS_SEG_SHANK },   { K_RHIP, GS_SEG_THIGH },
+    { K_RKNE, GS_SEG_SHANK },     { K_LKNE, GS_SEG_FOOT },    { K_RKNE, GS_SEG_FOOT },
+};
+
+/* BlazePose hand or foot from its own keypoints (added to bits); false when they are missing. */
+static bool blaze_extremity(const frame *f, int dist, bool hand, float c, vec2 *com, uint32_t *bits)
 {
-    if (!f->have[wri]) {
-        return;
-    }
-    vec2 w = f->p[wri];
-    if (blaze && (f->obs[pinky] || f->obs[index])) {
+    vec2 q = f->p[dist];
+    if (hand) {
+        /* BlazePose pinky and index knuckles lie 12 and 14 after the wrist */
+        int pinky = dist + (K_LPINKY - K_LWRI), index = dist + (K_LINDEX - K_LWRI);
         vec2 mcp;
-        if (f->obs[pinky] && f->obs[index]) {
-            mcp = v_mid(f->p[pinky], f->p[index]);
-        } else {
-            mcp = f->obs[pinky] ? f->p[pinky] : f->p[index];
+        if (!centre_of(f, f->obs, pinky, index, &mcp)) {
+            return false;
         }
-        use(f, pinky);
-        use(f, index);
-        use(f, wri);
-        add_segment(f, m, v_lerp(w, mcp, e_hand / WRIST_MCP_OVER_FOREARM), !f->obs[wri]);
-    } else if (f->have[elb]) {
-        use(f, wri);
-        add_segment(f, m, v_add(w, v_scale(v_sub(w, f->p[elb]), e_hand)), is_rebuilt(f, elb, wri));
-    } else {
-        use(f, wri);
-        add_segment(f, m, w, true);
+        *com = v_lerp(q, mcp, c / WRIST_MCP_OVER_FOREARM);
+        *bits |= BIT2(pinky, index);
+        return true;
     }
+    /* heel and toe tip lie 2 and 4 after the ankle */
+    int heel = dist + (K_LHEEL - K_LANK), toe = dist + (K_LTOE - K_LANK);
+    if (!all_in(f->obs, BIT2(heel, toe))) {
+        return false;
+    }
+    /* halfway between the ankle and the sole point at c: foot COM is ~3 cm above the floor */
+    *com = v_mid(q, v_lerp(f->p[heel], f->p[toe], c));
+    *bits |= BIT2(heel, toe);
+    return true;
 }
 
-static void add_foot(frame *f, bool blaze, int kne, int ank, int heel, int toe, float m, float c_foot)
+/* One limb segment: an arm or leg bone between its joints, or a hand or foot
+ * beyond the distal joint (wrist/ankle), from the BlazePose extremity keypoints,
+ * else along the forearm/shank, else at the joint itself. */
+static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
 {
-    if (!f->have[ank]) {
+    int prox = d->prox, dist = prox + NEXT_JOINT;
+    bool hand = d->seg == GS_SEG_HAND, extremity = hand || d->seg == GS_SEG_FOOT;
+    bool has_prox = f->have & BIT(prox);
+    if (!(f->have & BIT(dist)) || (!extremity && !has_prox)) {
         return;
     }
-    vec2 a = f->p[ank];
-    if (blaze && f->obs[heel] && f->obs[toe]) {
-        /* halfway between the ankle and the sole point at c_foot: foot COM is ~3 cm above the floor */
-        vec2 sole = v_lerp(f->p[heel], f->p[toe], c_foot);
-        use(f, heel);
-        use(f, toe);
-        use(f, ank);
-        add_segment(f, m, v_mid(a, sole), !f->obs[ank]);
-    } else if (f->have[kne]) {
-        use(f, ank);
-        add_segment(f, m, v_add(a, v_scale(v_sub(a, f->p[kne]), FOOT_BELOW_ANKLE)), is_rebuilt(f, kne, ank));
-    } else {
-        use(f, ank);
-        add_segment(f, m, a, true);
+    vec2 q = f->p[dist], com = q;
+    uint32_t bits = BIT(dist);
+    bool rebuilt = is_rebuilt(f, prox, dist); /* also when prox is missing */
+    if (!extremity) {
+        com = v_lerp(f->p[prox], q, c);
+        bits |= BIT(prox);
+    } else if (GS_WITH_BLAZEPOSE33 && f->blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
+        rebuilt = !(f->obs & BIT(dist));
+    } else if (has_prox) {
+        com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
+    }
+    add_segment(f, m, com, rebuilt, bits);
+}
+
+static void add_limbs(frame *f, const seg_table *tb)
+{
+    for (size_t i = 0; i < sizeof k_limb_segs / sizeof k_limb_segs[0]; i++) {
+        const seg_def *d = &k_limb_segs[i];
+        add_limb_segment(f, d, tb->mass_pct[d->seg], tb->c[d->seg]);
     }
 }
 
 /* ---- stature and axis ---------------------------------------------------------- */
 
-typedef struct {
-    float sw, sx, sy, sf;
-} group;
-
-static void group_add(group *g, const frame *f, int k, float frac, float prior)
-{
-    if (!f->obs[k]) {
-        return;
-    }
-    float w = f->c[k] * prior;
-    g->sw += w;
-    g->sx += w * f->p[k].x;
-    g->sy += w * f->p[k].y;
-    g->sf += w * frac;
-}
+/* Stature landmarks in summation order, head group first; fraction and prior per kind. */
+enum { M_EYE, M_EAR, M_NOSE, M_ANKLE, M_HEEL, M_TOE, M_KINDS };
+static const float k_mark_frac[M_KINDS] = { F_EYE, F_EAR, F_NOSE, F_ANKLE, F_HEEL, F_TOE };
+static const float k_mark_prior[M_KINDS] = { P_EYE, P_EAR, P_NOSE, P_ANKLE, P_HEEL, P_TOE };
+static const uint8_t k_marks[][2] = {
+    { K_LEYE, M_EYE },     { K_REYE, M_EYE },     { K_LEAR, M_EAR },   { K_REAR, M_EAR },
+    { K_NOSE, M_NOSE },    { K_LANK, M_ANKLE },   { K_RANK, M_ANKLE }, { K_LHEEL, M_HEEL },
+    { K_RHEEL, M_HEEL },   { K_LTOE, M_TOE },     { K_RTOE, M_TOE },
+};
 
 /* Weighted head and foot landmark centroids with their mean height fractions;
  * stature = their distance along the body axis / the fraction difference.
  * Called before any keypoint is rebuilt (have == obs). */
 static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 {
-    group h = { 0 }, ft = { 0 };
-    group_add(&h, f, K_LEYE, F_EYE, P_EYE);
-    group_add(&h, f, K_REYE, F_EYE, P_EYE);
-    group_add(&h, f, K_LEAR, F_EAR, P_EAR);
-    group_add(&h, f, K_REAR, F_EAR, P_EAR);
-    group_add(&h, f, K_NOSE, F_NOSE, P_NOSE);
-    group_add(&ft, f, K_LANK, F_ANKLE, P_ANKLE);
-    group_add(&ft, f, K_RANK, F_ANKLE, P_ANKLE);
-    group_add(&ft, f, K_LHEEL, F_HEEL, P_HEEL);
-    group_add(&ft, f, K_RHEEL, F_HEEL, P_HEEL);
-    group_add(&ft, f, K_LTOE, F_TOE, P_TOE);
-    group_add(&ft, f, K_RTOE, F_TOE, P_TOE);
-    if (!(h.sw > 0.0f) || !(ft.sw > 0.0f)) {
+    wsum g[2] = { { 0.0f, 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f } }; /* head, feet; e: height fraction */
+    for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
+        int k = k_marks[i][0], kind = k_marks[i][1];
+        if (!(f->obs & BIT(k))) {
+            continue;
+        }
+        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k], k_mark_frac[kind]);
+    }
+    const wsum *h = &g[0], *ft = &g[1];
+    if (!(h->w > 0.0f) || !(ft->w > 0.0f)) {
         return false;
     }
-    vec2 hc = { h.sx / h.sw, h.sy / h.sw };
-    vec2 fc = { ft.sx / ft.sw, ft.sy / ft.sw };
+    vec2 hc = wsum_mean(h), fc = wsum_mean(ft);
     /* Axis along the posture plumb line ear -> ankle when seen: eyes, nose and
      * toes sit in front of it and would tilt it forward in a lateral view. */
     vec2 ha = hc, fa = fc;
-    if (!pair_centre(f, K_LEAR, K_REAR, &ha) && !pair_centre(f, K_LEYE, K_REYE, &ha)) {
-        ha = hc;
+    if (!pair_centre(f, f->have, K_LEAR, &ha)) {
+        pair_centre(f, f->have, K_LEYE, &ha);
     }
-    if (!pair_centre(f, K_LANK, K_RANK, &fa)) {
-        fa = fc;
-    }
+    pair_centre(f, f->have, K_LANK, &fa);
     vec2 d = v_sub(ha, fa);
     float len = v_len(d);
     if (!(len > 0.0f)) {
         return false;
     }
     *up = v_scale(d, 1.0f / len);
-    *stature_px = v_dot(v_sub(hc, fc), *up) / (h.sf / h.sw - ft.sf / ft.sw);
+    *stature_px = v_dot(v_sub(hc, fc), *up) / (h->e / h->w - ft->e / ft->w);
     return true;
 }
 
@@ -415,14 +469,7 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 static float nose_ankle_stature(const frame *f)
 {
     vec2 a;
-    if (!f->obs[K_NOSE]) {
-        return NAN;
-    }
-    if (f->obs[K_LANK] && f->obs[K_RANK]) {
-        a = v_mid(f->p[K_LANK], f->p[K_RANK]);
-    } else if (f->obs[K_LANK] || f->obs[K_RANK]) {
-        a = f->obs[K_LANK] ? f->p[K_LANK] : f->p[K_RANK];
-    } else {
+    if (!(f->obs & BIT(K_NOSE)) || !pair_centre(f, f->obs, K_LANK, &a)) {
         return NAN;
     }
     return NOSE_ANKLE_FACTOR * v_len(v_sub(f->p[K_NOSE], a));
@@ -438,22 +485,22 @@ static float min_nan(float acc, float v)
     return (isnan(acc) || v < acc) ? v : acc;
 }
 
-static float upright_score(const frame *f, bool have_trunk, vec2 s, vec2 p, bool axis_from_body, vec2 up)
+
+/* trunk = shoulder centre - hip centre, trunk_len its length (0 without a trunk). */
+static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axis_from_body, vec2 up)
 {
-    static const int side[2][4] = { { K_LSHO, K_LHIP, K_LKNE, K_LANK }, { K_RSHO, K_RHIP, K_RKNE, K_RANK } };
     float knee = NAN, other = NAN;
-    float trunk_len = have_trunk ? v_len(v_sub(s, p)) : 0.0f;
-    for (int i = 0; i < 2; i++) {
-        int sh = side[i][0], hp = side[i][1], kn = side[i][2], an = side[i][3];
-        if (!f->obs[hp] || !f->obs[kn] || !f->obs[an]) {
+    for (int i = 0; i < 2; i++) { /* the right keypoint follows the left one */
+        int sh = K_LSHO + i, hp = K_LHIP + i, kn = K_LKNE + i, an = K_LANK + i;
+        if (!all_in(f->obs >> i, BIT(K_LHIP) | BIT(K_LKNE) | BIT(K_LANK))) {
             continue;
         }
-        knee = min_nan(knee, ramp(angle_deg(f->p[hp], f->p[kn], f->p[an]), KNEE_DEG_0, KNEE_DEG_1));
-        if (f->obs[sh]) {
-            other = min_nan(other, ramp(angle_deg(f->p[sh], f->p[hp], f->p[kn]), HIP_DEG_0, HIP_DEG_1));
+        knee = min_nan(knee, ramp(angle_deg(f, hp, kn, an), KNEE_DEG_0, KNEE_DEG_1));
+        if ((f->obs >> i) & BIT(K_LSHO)) {
+            other = min_nan(other, ramp(angle_deg(f, sh, hp, kn), HIP_DEG_0, HIP_DEG_1));
         }
         if (trunk_len > 0.0f) {
-            float leg = v_len(v_sub(f->p[hp], f->p[kn])) + v_len(v_sub(f->p[kn], f->p[an]));
+            float leg = kp_dist(f, hp, kn) + kp_dist(f, kn, an);
             other = min_nan(other, ramp(leg / trunk_len, LEG_TRUNK_0, LEG_TRUNK_1));
         }
     }
@@ -461,11 +508,28 @@ static float upright_score(const frame *f, bool have_trunk, vec2 s, vec2 p, bool
         return NAN; /* legs missing: cannot tell */
     }
     if (axis_from_body && trunk_len > 0.0f) {
-        float cs = v_dot(v_sub(s, p), up) / trunk_len;
-        cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
-        other = min_nan(other, ramp(GS_ACOSF(cs) * RAD_TO_DEG, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1));
+        float tilt_deg = acos_deg(v_dot(trunk, up) / trunk_len);
+        other = min_nan(other, ramp(tilt_deg, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1));
     }
     return min_nan(knee, other);
+}
+
+/* Rebuild lost limb joints from the other side (mirror across the mid-plane). */
+static void mirror_limbs(frame *f, vec2 axis, float trunk_len)
+{
+    /* shoulder width / trunk length: ~0.7 frontal, ~0 lateral; else from the hips */
+    float width = NAN;
+    if (all_in(f->obs, BIT2(K_LSHO, K_RSHO))) {
+        width = kp_dist(f, K_LSHO, K_RSHO) / trunk_len;
+    } else if (all_in(f->obs, BIT2(K_LHIP, K_RHIP))) {
+        width = SHOULDER_OVER_HIP_WIDTH * kp_dist(f, K_LHIP, K_RHIP) / trunk_len;
+    }
+    /* no pair seen: one side hidden, i.e. a lateral view */
+    float across = isnan(width) ? 1.0f : 1.0f - 2.0f * ramp(width, LATERAL_MAX_WIDTH, MIRROR_MIN_WIDTH);
+    static const uint8_t prox[8] = { K_LSHO, K_LELB, K_RSHO, K_RELB, K_LHIP, K_LKNE, K_RHIP, K_RKNE };
+    for (int i = 0; i < 8; i++) {
+        mirror_joint(f, prox[i], axis, across);
+    }
 }
 
 #endif /* GS_WITH_POSE */
@@ -510,6 +574,96 @@ static void out_unknown(gs_com_out *out)
     out->upright = NAN;
 }
 
+#if GS_WITH_POSE
+/* Renormalise over the segments present; w falls with the square of what is missing.
+ * A COM out of float range leaves out unknown (NaN, w = 0). */
+static void com_result(const frame *f, float total, gs_com_out *out)
+{
+    vec2 com = wsum_mean(&f->com);
+    float csum = 0.0f;
+    int n = 0;
+    for (int k = 0; k < K_N; k++) {
+        if (f->used & BIT(k)) {
+            csum += f->c[k];
+            n++;
+        }
+    }
+    float frac = f->com.e / total;
+    float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
+    /* a segment missing outright (not even rebuilt from its mirror, e.g. the head
+     * out of the frame at the apex) biases the renormalised COM by centimetres:
+     * such frames count only when nothing better exists */
+    if (f->com.w < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
+    if (isfinite(com.x) && isfinite(com.y)) {
+        out->x_px = com.x;
+        out->y_px = com.y;
+        out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
+    }
+}
+
+static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_method stature,
+                         float min_conf, const gs_kp *kp, gs_com_out *out)
+{
+    frame f;
+    load(&f, GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33), min_conf, kp);
+
+    /* Stature and body axis do not need the trunk. */
+    vec2 up = { NAN, NAN };
+    float st = NAN;
+    bool axis_from_body = anthro_stature(&f, &st, &up);
+    if (stature == GS_STATURE_NOSE_ANKLE_117) {
+        st = nose_ankle_stature(&f);
+    }
+    if (isfinite(st)) { /* else NaN: absurd coordinates overflow float */
+        out->stature_px = st;
+    }
+    if (!isfinite(up.x) || !isfinite(up.y)) {
+        up = (vec2){ NAN, NAN };
+        axis_from_body = false;
+    }
+
+    /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
+    rebuild_trunk_corner(&f, K_LSHO, K_LHIP, SHOULDER_OVER_HIP_WIDTH);
+    rebuild_trunk_corner(&f, K_LHIP, K_LSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
+    vec2 s = { NAN, NAN }, p = { NAN, NAN }, trunk = { 0.0f, 0.0f };
+    bool have_trunk = pair_centre(&f, f.have, K_LSHO, &s) && pair_centre(&f, f.have, K_LHIP, &p);
+    float trunk_len = 0.0f;
+    if (have_trunk) {
+        trunk = v_sub(s, p);
+        trunk_len = v_len(trunk);
+    }
+    if (trunk_len > 0.0f) {
+        vec2 axis = v_scale(trunk, 1.0f / trunk_len);
+        if (!axis_from_body) {
+            up = axis; /* fallback axis: hip centre -> shoulder centre */
+        }
+        /* lost limb joints from the other side (writes only keypoints not observed) */
+        mirror_limbs(&f, axis, trunk_len);
+    }
+    if (!isnan(up.x)) {
+        out->up_x = up.x;
+        out->up_y = up.y;
+    }
+    out->upright = upright_score(&f, trunk, trunk_len, axis_from_body, up);
+
+    if (!have_trunk) {
+        return; /* w = 0: without the trunk (half the mass) the COM is a guess */
+    }
+    const uint32_t corners = BIT2(K_LSHO, K_RSHO) | BIT2(K_LHIP, K_RHIP);
+    bool trunk_rebuilt = !all_in(f.obs, corners);
+
+    vec2 hc = { 0.0f, 0.0f };
+    bool head_rebuilt;
+    uint32_t head_bits = head_centre(&f, &hc, &head_rebuilt);
+    if (head_bits) {
+        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, head_rebuilt, head_bits);
+    }
+    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], v_lerp(s, p, tb->c[GS_SEG_TRUNK]), trunk_rebuilt, corners);
+    add_limbs(&f, tb);
+    com_result(&f, table_total_pct(tb), out);
+}
+#endif
+
 gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_method stature,
                          float min_conf, const gs_kp *kp, gs_com_out *out)
 {
@@ -523,122 +677,15 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
 
     if (layout == GS_LAYOUT_POINT) {
         out->upright = 1.0f; /* a rigid object is always "upright" */
-        const gs_kp *q = &kp[0];
-        if (isfinite(q->c) && q->c > 0.0f && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px)) {
-            out->x_px = q->x_px;
-            out->y_px = q->y_px;
-            out->w = q->c > 1.0f ? 1.0f : q->c;
+        if (kp_usable(kp, min_conf)) {
+            out->x_px = kp->x_px;
+            out->y_px = kp->y_px;
+            out->w = conf01(kp->c);
         }
         return GS_OK;
     }
 #if GS_WITH_POSE
-    const seg_table *tb = &k_tables[table];
-    const float total = table_total_pct(tb);
-    const bool blaze = GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33);
-    frame f;
-    load(&f, layout, min_conf, kp);
-
-    /* Stature and body axis do not need the trunk. */
-    vec2 up = { NAN, NAN };
-    float st = NAN;
-    bool axis_from_body = anthro_stature(&f, &st, &up);
-    if (stature == GS_STATURE_NOSE_ANKLE_117) {
-        st = nose_ankle_stature(&f);
-    }
-    out->stature_px = isfinite(st) ? st : NAN; /* absurd coordinates overflow float */
-    if (!isfinite(up.x) || !isfinite(up.y)) {
-        up = (vec2){ NAN, NAN };
-        axis_from_body = false;
-    }
-
-    /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
-    rebuild_trunk_corner(&f, K_LSHO, K_RSHO, K_LHIP, K_RHIP, SHOULDER_OVER_HIP_WIDTH);
-    rebuild_trunk_corner(&f, K_LHIP, K_RHIP, K_LSHO, K_RSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
-    vec2 s = { NAN, NAN }, p = { NAN, NAN };
-    bool have_trunk = pair_centre(&f, K_LSHO, K_RSHO, &s) && pair_centre(&f, K_LHIP, K_RHIP, &p);
-
-    if (!axis_from_body && have_trunk && v_len(v_sub(s, p)) > 0.0f) {
-        vec2 d = v_sub(s, p); /* fallback axis: hip centre -> shoulder centre */
-        up = v_scale(d, 1.0f / v_len(d));
-    }
-    if (!isnan(up.x)) {
-        out->up_x = up.x;
-        out->up_y = up.y;
-    }
-    out->upright = upright_score(&f, have_trunk, s, p, axis_from_body, up);
-
-    if (!have_trunk) {
-        return GS_OK; /* w = 0: without the trunk (half the mass) the COM is a guess */
-    }
-
-    /* Rebuild a lost limb joint from the other side (mirror across the mid-plane). */
-    vec2 trunk = v_sub(s, p);
-    float trunk_len = v_len(trunk);
-    bool corners = f.obs[K_LSHO] && f.obs[K_RSHO] && f.obs[K_LHIP] && f.obs[K_RHIP];
-    if (trunk_len > 0.0f) {
-        float width = NAN; /* shoulder width / trunk length: ~0.7 frontal, ~0 lateral */
-        if (f.obs[K_LSHO] && f.obs[K_RSHO]) {
-            width = v_len(v_sub(f.p[K_LSHO], f.p[K_RSHO])) / trunk_len;
-        } else if (f.obs[K_LHIP] && f.obs[K_RHIP]) {
-            width = SHOULDER_OVER_HIP_WIDTH * v_len(v_sub(f.p[K_LHIP], f.p[K_RHIP])) / trunk_len;
-        }
-        /* no pair seen: one side hidden, i.e. a lateral view */
-        float across = isnan(width) ? 1.0f : 1.0f - 2.0f * ramp(width, LATERAL_MAX_WIDTH, MIRROR_MIN_WIDTH);
-        vec2 axis = v_scale(trunk, 1.0f / trunk_len);
-        static const int chain[4][3] = {
-            { K_LSHO, K_LELB, K_LWRI }, { K_RSHO, K_RELB, K_RWRI },
-            { K_LHIP, K_LKNE, K_LANK }, { K_RHIP, K_RKNE, K_RANK } };
-        for (int c = 0; c < 4; c++) {
-            const int *own = chain[c], *oth = chain[c ^ 1];
-            mirror_joint(&f, own[0], own[1], oth[0], oth[1], axis, across);
-            mirror_joint(&f, own[1], own[2], oth[1], oth[2], axis, across);
-        }
-    }
-
-    vec2 hc = {0.0f, 0.0f};
-    bool head_rebuilt;
-    if (head_centre(&f, &hc, &head_rebuilt)) {
-        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, head_rebuilt);
-    }
-    bool trunk_rebuilt = !corners;
-    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], v_lerp(s, p, tb->c_trunk), trunk_rebuilt);
-    use(&f, K_LSHO);
-    use(&f, K_RSHO);
-    use(&f, K_LHIP);
-    use(&f, K_RHIP);
-
-    const float *m = tb->mass_pct;
-    add_limb(&f, K_LSHO, K_LELB, K_LWRI, m[GS_SEG_UPPER_ARM], tb->c_upper_arm, m[GS_SEG_FOREARM], tb->c_forearm);
-    add_limb(&f, K_RSHO, K_RELB, K_RWRI, m[GS_SEG_UPPER_ARM], tb->c_upper_arm, m[GS_SEG_FOREARM], tb->c_forearm);
-    add_hand(&f, blaze, K_LELB, K_LWRI, K_LPINKY, K_LINDEX, m[GS_SEG_HAND], tb->e_hand);
-    add_hand(&f, blaze, K_RELB, K_RWRI, K_RPINKY, K_RINDEX, m[GS_SEG_HAND], tb->e_hand);
-    add_limb(&f, K_LHIP, K_LKNE, K_LANK, m[GS_SEG_THIGH], tb->c_thigh, m[GS_SEG_SHANK], tb->c_shank);
-    add_limb(&f, K_RHIP, K_RKNE, K_RANK, m[GS_SEG_THIGH], tb->c_thigh, m[GS_SEG_SHANK], tb->c_shank);
-    add_foot(&f, blaze, K_LKNE, K_LANK, K_LHEEL, K_LTOE, m[GS_SEG_FOOT], tb->c_foot);
-    add_foot(&f, blaze, K_RKNE, K_RANK, K_RHEEL, K_RTOE, m[GS_SEG_FOOT], tb->c_foot);
-
-    /* Renormalise over the segments present; w falls with the square of what is missing. */
-    out->x_px = f.sx / f.m_sum;
-    out->y_px = f.sy / f.m_sum;
-    float csum = 0.0f;
-    int n = 0;
-    for (int k = 0; k < K_N; k++) {
-        if (f.used & (1u << k)) {
-            csum += f.c[k];
-            n++;
-        }
-    }
-    float frac = f.m_obs / total;
-    float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
-    /* a segment missing outright (not even rebuilt from its mirror, e.g. the head
-     * out of the frame at the apex) biases the renormalised COM by centimetres:
-     * such frames count only when nothing better exists */
-    if (f.m_sum < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
-    out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
-    if (!isfinite(out->x_px) || !isfinite(out->y_px)) {
-        out->x_px = out->y_px = NAN;
-        out->w = 0.0f;
-    }
+    skeleton_com(layout, &k_tables[table], stature, min_conf, kp, out);
 #endif
     return GS_OK;
 }
