@@ -6,6 +6,8 @@
 #include <string.h>
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
+#include "gs_dfinite.h"
+
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
 #define GS_FIT_SINGULAR_REL (sizeof(gs_real) < sizeof(double) ? GS_R(1e-5) : GS_R(1e-9))
@@ -28,24 +30,14 @@ static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
 void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
 {
-    int k;
     if (!f) {
         return;
     }
-    f->t0_s = isfinite(t0_s) ? t0_s : 0.0;
+    /* all sums and R zero (all-zero bits are +0.0), no samples */
+    memset(f, 0, sizeof *f);
+    f->t0_s = gs_double_finite(t0_s) ? t0_s : 0.0;
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    f->tscale_s = (isfinite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0;
-    for (k = 0; k < 6; k++) {
-        f->r[k] = GS_R(0.0);
-    }
-    for (k = 0; k < 3; k++) {
-        f->zx[k] = GS_R(0.0);
-        f->zy[k] = GS_R(0.0);
-    }
-    f->ssr_x = GS_R(0.0);
-    f->ssr_y = GS_R(0.0);
-    f->sum_w = GS_R(0.0);
-    f->n = 0;
+    f->tscale_s = (gs_double_finite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0;
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -55,16 +47,18 @@ static int rix(int i, int j)
     return base[i] + (j - i);
 }
 
-void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
+/* The centred, scaled time of an absolute time t_s (the fit's one double step). */
+static gs_real fit_tau(double t_s, double t0_s, double tscale_s)
 {
-    gs_real v[3], bx, by, sw, tau;
+    return (gs_real)((t_s - t0_s) / tscale_s);
+}
+
+/* Rotate the weighted row (1, tau, tau^2 | x, y) into R; w > 0 and all values finite. */
+static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real w)
+{
+    gs_real v[3], bx, by, sw;
     int k, j;
-    if (!f || !(w > 0.0) || !isfinite(w) || !isfinite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
-        return;
-    }
     sw = sqrt((gs_real)w);
-    /* the one double step: an absolute time minus the fit's centre */
-    tau = (gs_real)((t_s - f->t0_s) / f->tscale_s);
     v[0] = sw;
     v[1] = sw * tau;
     v[2] = sw * tau * tau;
@@ -99,6 +93,14 @@ void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
     f->ssr_y += by * by;
     f->sum_w += (gs_real)w;
     f->n++;
+}
+
+void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
+{
+    if (!f || !(w > 0.0) || !isfinite(w) || !gs_double_finite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
+        return;
+    }
+    add_row(f, fit_tau(t_s, f->t0_s, f->tscale_s), x_px, y_px, w);
 }
 
 static void nan_result(gs_fit_result *out)
@@ -233,29 +235,31 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
     return xorshift32(state) % n;
 }
 
-/* What a fit reads of a ring sample, unpacked. */
+/* What a fit reads of a usable ring sample, unpacked. */
 typedef struct {
-    double t_s;  /* absolute time: only differences from the window's centre leave double */
+    gs_real tau;  /* centred, scaled time in the window */
     float x_px, y_px, w;
 } gs_fsamp;
 
-/* Window sample i unpacked into *buf; NULL when the ring no longer holds it. */
-static const gs_fsamp *win_at(const gs_ring *ring, uint64_t idx, gs_fsamp *buf)
+/* A held sample with a weight and a position takes part in the fits. */
+static bool sample_usable(const gs_sample *s)
 {
-    const gs_sample *s = gs_ring_at(ring, idx);
-    if (!s) {
-        return NULL;
-    }
-    buf->t_s = gs_ring_sample_t_s(ring, s);
-    buf->x_px = s->x_px;
-    buf->y_px = s->y_px;
-    buf->w = gs_sample_w(s);
-    return buf;
+    return gs_sample_w(s) > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
 }
 
-static bool sample_usable(const gs_fsamp *s)
+/* Window sample i unpacked into *out when it is held and usable; false otherwise. */
+static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
 {
-    return s && s->w > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
+    const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+    if (!s || !sample_usable(s)) {
+        return false;
+    }
+    /* absolute times meet in double; the centred, unit-length tau fits a float */
+    out->tau = fit_tau(gs_ring_sample_t_s(wn->ring, s), wn->t0_s, wn->tscale_s);
+    out->x_px = s->x_px;
+    out->y_px = s->y_px;
+    out->w = gs_sample_w(s);
+    return true;
 }
 
 bool gs_fit_kept(const uint32_t *keep, uint32_t i)
@@ -269,30 +273,25 @@ static void keep_set(uint32_t *keep, uint32_t i, bool on)
     keep[i >> 5] = on ? (keep[i >> 5] | bit) : (keep[i >> 5] & ~bit);
 }
 
-static gs_real win_tau(const gs_win *wn, const gs_fsamp *s)
-{
-    /* absolute times meet in double; the centred, unit-length tau fits a float */
-    return (gs_real)((s->t_s - wn->t0_s) / wn->tscale_s);
-}
-
 /* Squared 2D distance of a sample from the parabola, in px^2. */
-static gs_real resid2(const gs_par *p, gs_real tau, const gs_fsamp *s)
+static gs_real resid2(const gs_par *p, const gs_fsamp *s)
 {
+    gs_real tau = s->tau;
     gs_real ex = (gs_real)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
     gs_real ey = (gs_real)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
     return ex * ex + ey * ey;
 }
 
 /* 2D distance of a sample from the parabola, in px. */
-static gs_real resid_norm(const gs_par *p, gs_real tau, const gs_fsamp *s)
+static gs_real resid_norm(const gs_par *p, const gs_fsamp *s)
 {
-    return sqrt(resid2(p, tau, s));
+    return sqrt(resid2(p, s));
 }
 
 /* The parabola through three samples (Newton divided differences); false when two times coincide. */
-static bool par_through(const gs_win *wn, const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
+static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
 {
-    gs_real ta = win_tau(wn, a), tb = win_tau(wn, b), tc = win_tau(wn, c);
+    gs_real ta = a->tau, tb = b->tau, tc = c->tau;
     gs_real dab = tb - ta, dac = tc - ta, dbc = tc - tb;
     int axis;
     if (dab == GS_R(0.0) || dac == GS_R(0.0) || dbc == GS_R(0.0)) {
@@ -334,11 +333,10 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
         uint32_t cnt[16] = {0};
         uint32_t d = 0;
         for (i = 0; i < wn->count; i++) {
-            gs_fsamp sb;
-            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
-            if (sample_usable(s)) {
+            gs_fsamp s;
+            if (win_usable(wn, i, &s)) {
                 /* squares order like norms: one sqrt for the median instead of one per sample */
-                float r2 = (float)resid2(p, win_tau(wn, s), s);
+                float r2 = (float)resid2(p, &s);
                 uint32_t key;
                 memcpy(&key, &r2, sizeof key);
                 if ((key & mask) == prefix) {
@@ -372,16 +370,13 @@ static gs_real tukey(gs_real r, gs_real cut)
 /* Final weight of one sample under a model: prior * robust factor, as a float. */
 typedef enum { W_PRIOR, W_TUKEY, W_INLIER } w_mode;
 
-static float sample_weight(const gs_win *wn, const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut)
+static float sample_weight(const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut)
 {
     gs_real r;
-    if (!sample_usable(s)) {
-        return 0.0f;
-    }
     if (mode == W_PRIOR) {
         return s->w;
     }
-    r = resid_norm(p, win_tau(wn, s), s);
+    r = resid_norm(p, s);
     if (mode == W_INLIER) {
         return r <= cut ? s->w : 0.0f;
     }
@@ -397,12 +392,12 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     uint32_t i;
     gs_fit_init(&f, wn->t0_s, wn->tscale_s);
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp sb;
-        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
-        float w = sample_weight(wn, s, model, mode, cut);
+        gs_fsamp s;
+        float w = win_usable(wn, i, &s) ? sample_weight(&s, model, mode, cut) : 0.0f;
         keep_set(keep, i, w > 0.0f);
         if (w > 0.0f) {
-            gs_fit_add(&f, s->t_s, s->x_px, s->y_px, (gs_real)w);
+            /* as gs_fit_add would: the fit shares the window's centre and scale */
+            add_row(&f, s.tau, s.x_px, s.y_px, (gs_real)w);
         }
     }
     st = gs_fit_solve(&f, out);
@@ -422,7 +417,7 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
     }
     for (i = 0; i < wn->count; i++) {
         gs_fsamp sb;
-        if (sample_usable(win_at(wn->ring, wn->first + i, &sb))) {
+        if (win_usable(wn, i, &sb)) {
             if (k == 0) {
                 return i;
             }
@@ -430,6 +425,17 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
         }
     }
     return wn->count - 1;
+}
+
+/* The parabola through the ka-th, kb-th and kc-th usable samples (par_through). */
+static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint32_t kc, gs_par *p)
+{
+    gs_fsamp a, b, c;
+    /* the window was checked to be held, and usable_index finds usable samples */
+    win_usable(wn, usable_index(wn, ka), &a);
+    win_usable(wn, usable_index(wn, kb), &b);
+    win_usable(wn, usable_index(wn, kc), &c);
+    return par_through(&a, &b, &c, p);
 }
 
 /* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
@@ -446,13 +452,9 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         uint32_t ka = rand_below(&state, third);
         uint32_t kb = third + rand_below(&state, third);
         uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
-        gs_fsamp ab, bb, cb;
-        const gs_fsamp *a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
-        const gs_fsamp *b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
-        const gs_fsamp *c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
         gs_par p;
         gs_real med;
-        if (!par_through(wn, a, b, c, &p)) {
+        if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
         med = median_resid(wn, &p);
@@ -486,10 +488,10 @@ static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
 }
 
 /* Tukey biweight IRLS from a start; *fin receives the converged curve. */
-static gs_status irls_from(const gs_win *wn, gs_par cur, gs_real floor_px, uint32_t *keep,
+static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
                            gs_fit_result *out, gs_par *fin)
 {
-    gs_par next;
+    gs_par cur = *start, next;
     gs_real med, scale;
     int it;
     gs_status st;
@@ -522,14 +524,13 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
     gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp sb;
-        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+        gs_fsamp s;
         gs_real u;
-        if (!sample_usable(s)) {
+        if (!win_usable(wn, i, &s)) {
             continue;
         }
-        u = sqrt(resid2(p, win_tau(wn, s), s)) / cut;
-        loss += (gs_real)s->w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
+        u = sqrt(resid2(p, &s)) / cut;
+        loss += (gs_real)s.w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
     }
     return loss;
 }
@@ -547,10 +548,10 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     if (!have_lms && !have_plain) {
         return GS_EINVAL;
     }
-    if (have_lms && irls_from(wn, lms, floor_px, keep, out, &fin_lms) == GS_OK) {
+    if (have_lms && irls_from(wn, &lms, floor_px, keep, out, &fin_lms) == GS_OK) {
         loss_lms = tukey_loss(wn, &fin_lms, floor_px);
     }
-    if (have_plain && irls_from(wn, plain, floor_px, keep, out, &fin_plain) == GS_OK) {
+    if (have_plain && irls_from(wn, &plain, floor_px, keep, out, &fin_plain) == GS_OK) {
         loss_plain = tukey_loss(wn, &fin_plain, floor_px);
     }
     if (!(loss_plain <= loss_lms)) {
@@ -558,7 +559,7 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
             return GS_EINVAL;
         }
         /* the LMS run won: run it again so keep and out hold its weights */
-        return irls_from(wn, lms, floor_px, keep, out, &fin_lms);
+        return irls_from(wn, &lms, floor_px, keep, out, &fin_lms);
     }
     return GS_OK;
 }
@@ -575,28 +576,22 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
         uint32_t ka = rand_below(&state, m);
         uint32_t kb = rand_below(&state, m);
         uint32_t kc = rand_below(&state, m);
-        gs_fsamp ab, bb, cb;
-        const gs_fsamp *a, *b, *c;
         gs_par p;
         uint32_t n_in = 0;
         gs_real cost = GS_R(0.0);
         if (ka == kb || ka == kc || kb == kc) {
             continue;
         }
-        a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
-        b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
-        c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
-        if (!par_through(wn, a, b, c, &p)) {
+        if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
         for (i = 0; i < wn->count; i++) {
-            gs_fsamp sb;
-            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+            gs_fsamp s;
             gs_real r2;
-            if (!sample_usable(s)) {
+            if (!win_usable(wn, i, &s)) {
                 continue;
             }
-            r2 = resid2(&p, win_tau(wn, s), s);
+            r2 = resid2(&p, &s);
             if (r2 <= thr * thr) {
                 n_in++;
                 cost += r2;
@@ -637,19 +632,19 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
         keep_set(keep, i, false);
     }
     for (i = 0; i < count; i++) {
-        gs_fsamp sb;
-        const gs_fsamp *s = win_at(ring, first + i, &sb);
+        const gs_sample *s = gs_ring_at(ring, first + i);
         if (!s) {
             /* Overwritten or not yet written: the window is gone. */
             return GS_EINVAL;
         }
         if (sample_usable(s)) {
+            double t_s = gs_ring_sample_t_s(ring, s);
             m++;
-            if (s->t_s < t_min) {
-                t_min = s->t_s;
+            if (t_s < t_min) {
+                t_min = t_s;
             }
-            if (s->t_s > t_max) {
-                t_max = s->t_s;
+            if (t_s > t_max) {
+                t_max = t_s;
             }
         }
     }

@@ -5,6 +5,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_dfinite.h"
+
 #define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~((size_t)(a) - 1u))
 
 size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
@@ -115,8 +117,8 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
 static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
 {
     if (p->finished) return GS_ESTATE;
-    if (!isfinite(s->t_s)) return GS_EINVAL;
-    if (isfinite(p->last_t_s)) {
+    if (!gs_double_finite(s->t_s)) return GS_EINVAL;
+    if (gs_double_finite(p->last_t_s)) {
         if (s->t_s < p->last_t_s) return GS_EORDER;
         if (s->t_s == p->last_t_s) return GS_OK;  /* a repeated frame carries nothing new */
     }
