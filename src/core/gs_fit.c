@@ -28,16 +28,22 @@
 
 static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
+/* An empty fit at a valid centre and scale: all sums and R zero (all-zero bits are +0.0). */
+static void fit_start(gs_fit *f, double t0_s, double tscale_s)
+{
+    memset(f, 0, sizeof *f);
+    f->t0_s = t0_s;
+    f->tscale_s = tscale_s;
+}
+
 void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
 {
     if (!f) {
         return;
     }
-    /* all sums and R zero (all-zero bits are +0.0), no samples */
-    memset(f, 0, sizeof *f);
-    f->t0_s = gs_double_finite(t0_s) ? t0_s : 0.0;
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    f->tscale_s = (gs_double_finite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0;
+    fit_start(f, gs_double_finite(t0_s) ? t0_s : 0.0,
+              (gs_double_finite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0);
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -53,17 +59,23 @@ static gs_real fit_tau(double t_s, double t0_s, double tscale_s)
     return (gs_real)((t_s - t0_s) / tscale_s);
 }
 
-/* Rotate the weighted row (1, tau, tau^2 | x, y) into R; w > 0 and all values finite. */
+/* Entry j of row k of the augmented factor [R | zx zy]: columns 0-2 are R's, 3 and 4 the right-hand sides. */
+static gs_real *aug_entry(gs_fit *f, int k, int j)
+{
+    return j < 3 ? &f->r[rix(k, j)] : j == 3 ? &f->zx[k] : &f->zy[k];
+}
+
+/* Rotate the weighted row (1, tau, tau^2 | x, y) into [R | zx zy]; w > 0 and all values finite. */
 static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real w)
 {
-    gs_real v[3], bx, by, sw;
+    gs_real v[5], sw;
     int k, j;
     sw = sqrt((gs_real)w);
     v[0] = sw;
     v[1] = sw * tau;
     v[2] = sw * tau * tau;
-    bx = sw * (gs_real)x_px;
-    by = sw * (gs_real)y_px;
+    v[3] = sw * (gs_real)x_px;
+    v[4] = sw * (gs_real)y_px;
     for (k = 0; k < 3; k++) {
         gs_real a = f->r[rix(k, k)];
         gs_real b = v[k];
@@ -74,23 +86,16 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
         rho = sqrt(a * a + b * b);
         c = a / rho;
         s = b / rho;
-        for (j = k; j < 3; j++) {
-            gs_real rkj = f->r[rix(k, j)];
-            f->r[rix(k, j)] = c * rkj + s * v[j];
+        for (j = k; j < 5; j++) {
+            gs_real *e = aug_entry(f, k, j);
+            gs_real rkj = *e;
+            *e = c * rkj + s * v[j];
             v[j] = c * v[j] - s * rkj;
-        }
-        {
-            gs_real zk = f->zx[k];
-            f->zx[k] = c * zk + s * bx;
-            bx = c * bx - s * zk;
-            zk = f->zy[k];
-            f->zy[k] = c * zk + s * by;
-            by = c * by - s * zk;
         }
     }
     /* What is left of the row after eliminating its basis part is its residual. */
-    f->ssr_x += bx * bx;
-    f->ssr_y += by * by;
+    f->ssr_x += v[3] * v[3];
+    f->ssr_y += v[4] * v[4];
     f->sum_w += (gs_real)w;
     f->n++;
 }
@@ -237,8 +242,9 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
 
 /* What a fit reads of a usable ring sample, unpacked. */
 typedef struct {
-    gs_real tau;  /* centred, scaled time in the window */
-    float x_px, y_px, w;
+    gs_real tau;    /* centred, scaled time in the window */
+    float xy_px[2]; /* x, y: indexed by axis like the parabola's coefficients */
+    float w;
 } gs_fsamp;
 
 /* A held sample with a weight and a position takes part in the fits. */
@@ -256,8 +262,8 @@ static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
     }
     /* absolute times meet in double; the centred, unit-length tau fits a float */
     out->tau = fit_tau(gs_ring_sample_t_s(wn->ring, s), wn->t0_s, wn->tscale_s);
-    out->x_px = s->x_px;
-    out->y_px = s->y_px;
+    out->xy_px[0] = s->x_px;
+    out->xy_px[1] = s->y_px;
     out->w = gs_sample_w(s);
     return true;
 }
@@ -277,8 +283,8 @@ static void keep_set(uint32_t *keep, uint32_t i, bool on)
 static gs_real resid2(const gs_par *p, const gs_fsamp *s)
 {
     gs_real tau = s->tau;
-    gs_real ex = (gs_real)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
-    gs_real ey = (gs_real)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
+    gs_real ex = (gs_real)s->xy_px[0] - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
+    gs_real ey = (gs_real)s->xy_px[1] - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
     return ex * ex + ey * ey;
 }
 
@@ -293,14 +299,14 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
 {
     gs_real ta = a->tau, tb = b->tau, tc = c->tau;
     gs_real dab = tb - ta, dac = tc - ta, dbc = tc - tb;
-    int axis;
+    int axis, k;
     if (dab == GS_R(0.0) || dac == GS_R(0.0) || dbc == GS_R(0.0)) {
         return false;
     }
     for (axis = 0; axis < 2; axis++) {
-        gs_real va = axis ? a->y_px : a->x_px;
-        gs_real vb = axis ? b->y_px : b->x_px;
-        gs_real vc = axis ? c->y_px : c->x_px;
+        gs_real va = a->xy_px[axis];
+        gs_real vb = b->xy_px[axis];
+        gs_real vc = c->xy_px[axis];
         gs_real sab = (vb - va) / dab;
         gs_real sac = (vc - va) / dac;
         gs_real c2 = (sac - sab) / dbc;
@@ -309,7 +315,9 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
         p->c[3 * axis + 0] = c0;
         p->c[3 * axis + 1] = c1;
         p->c[3 * axis + 2] = c2;
-        if (!isfinite(c0) || !isfinite(c1) || !isfinite(c2)) {
+    }
+    for (k = 0; k < 6; k++) {
+        if (!isfinite(p->c[k])) {
             return false;
         }
     }
@@ -390,14 +398,14 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     gs_fit f;
     gs_status st;
     uint32_t i;
-    gs_fit_init(&f, wn->t0_s, wn->tscale_s);
+    fit_start(&f, wn->t0_s, wn->tscale_s);  /* both finite, the scale positive */
     for (i = 0; i < wn->count; i++) {
         gs_fsamp s;
         float w = win_usable(wn, i, &s) ? sample_weight(&s, model, mode, cut) : 0.0f;
         keep_set(keep, i, w > 0.0f);
         if (w > 0.0f) {
             /* as gs_fit_add would: the fit shares the window's centre and scale */
-            add_row(&f, s.tau, s.x_px, s.y_px, (gs_real)w);
+            add_row(&f, s.tau, s.xy_px[0], s.xy_px[1], (gs_real)w);
         }
     }
     st = gs_fit_solve(&f, out);
@@ -487,33 +495,34 @@ static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
     return worst;
 }
 
-/* Tukey biweight IRLS from a start; *fin receives the converged curve. */
+/* Tukey biweight IRLS from a start; *fin (not start) receives the converged curve. */
 static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
                            gs_fit_result *out, gs_par *fin)
 {
-    gs_par cur = *start, next;
+    gs_par next;
     gs_real med, scale;
     int it;
     gs_status st;
+    bool settled;
+    *fin = *start;
     for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
-        med = median_resid(wn, &cur);
+        med = median_resid(wn, fin);
         /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
         scale = GS_FIT_MAD_K * med;
         if (!(scale >= floor_px)) {
             scale = floor_px;
         }
-        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
+        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
         if (st != GS_OK) {
             return st;
         }
         /* Settled when the curve moves by far less than the noise. */
-        if (par_max_shift_px(&cur, &next) <= GS_R(1e-6) * scale) {
-            cur = next;
+        settled = par_max_shift_px(fin, &next) <= GS_R(1e-6) * scale;
+        *fin = next;
+        if (settled) {
             break;
         }
-        cur = next;
     }
-    *fin = cur;
     return GS_OK;
 }
 
@@ -540,26 +549,27 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
  * chance subset better than all of them): the smaller robust loss wins. */
 static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
 {
-    gs_par lms, plain, fin_lms, fin_plain;
-    gs_real med;
-    bool have_lms = lmeds_start(wn, m, &lms, &med);
-    bool have_plain = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &plain, out) == GS_OK;
-    gs_real loss_lms = (gs_real)INFINITY, loss_plain = (gs_real)INFINITY;
-    if (!have_lms && !have_plain) {
+    enum { LMS, PLAIN, N_STARTS };
+    gs_par start[N_STARTS], fin;
+    gs_real med, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
+    bool have[N_STARTS];
+    int k;
+    have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
+    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out) == GS_OK;
+    if (!have[LMS] && !have[PLAIN]) {
         return GS_EINVAL;
     }
-    if (have_lms && irls_from(wn, &lms, floor_px, keep, out, &fin_lms) == GS_OK) {
-        loss_lms = tukey_loss(wn, &fin_lms, floor_px);
+    for (k = 0; k < N_STARTS; k++) {
+        if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
+            loss[k] = tukey_loss(wn, &fin, floor_px);
+        }
     }
-    if (have_plain && irls_from(wn, &plain, floor_px, keep, out, &fin_plain) == GS_OK) {
-        loss_plain = tukey_loss(wn, &fin_plain, floor_px);
-    }
-    if (!(loss_plain <= loss_lms)) {
-        if (!(loss_lms < (gs_real)INFINITY)) {
+    if (!(loss[PLAIN] <= loss[LMS])) {
+        if (!(loss[LMS] < (gs_real)INFINITY)) {
             return GS_EINVAL;
         }
         /* the LMS run won: run it again so keep and out hold its weights */
-        return irls_from(wn, &lms, floor_px, keep, out, &fin_lms);
+        return irls_from(wn, &start[LMS], floor_px, keep, out, &fin);
     }
     return GS_OK;
 }
@@ -615,7 +625,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
                         float min_scale_px, uint32_t *keep, gs_fit_result *out)
 {
     gs_win wn;
-    double t_min = (double)INFINITY, t_max = -(double)INFINITY;  /* absolute times */
+    double t_min = 0.0, t_max = 0.0;  /* absolute times */
     gs_real floor_px;
     uint32_t i, m = 0, n_pos = 0;
     gs_status st;
@@ -638,14 +648,12 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
             return GS_EINVAL;
         }
         if (sample_usable(s)) {
-            double t_s = gs_ring_sample_t_s(ring, s);
+            /* the ring's times never decrease: the first usable is the earliest, the last the latest */
+            t_max = gs_ring_sample_t_s(ring, s);
+            if (m == 0) {
+                t_min = t_max;
+            }
             m++;
-            if (t_s < t_min) {
-                t_min = t_s;
-            }
-            if (t_s > t_max) {
-                t_max = t_s;
-            }
         }
     }
     if (m < 3 || !(t_max > t_min)) {
