@@ -621,26 +621,12 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
     return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out);
 }
 
-gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
-                        float min_scale_px, uint32_t *keep, gs_fit_result *out)
+/* Opens the window [first, first+count): GS_EINVAL when a sample is no longer held
+ * or fewer than 3 usable ones at distinct times remain. */
+static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint32_t count)
 {
-    gs_win wn;
     double t_min = 0.0, t_max = 0.0;  /* absolute times */
-    gs_real floor_px;
-    uint32_t i, m = 0, n_pos = 0;
-    gs_status st;
-    if (!out) {
-        return GS_EINVAL;
-    }
-    out->t0_s = (double)NAN;
-    out->n = 0;
-    nan_result(out);
-    if (!ring || !keep || count == 0) {
-        return GS_EINVAL;
-    }
-    for (i = 0; i < count; i++) {
-        keep_set(keep, i, false);
-    }
+    uint32_t i, m = 0;
     for (i = 0; i < count; i++) {
         const gs_sample *s = gs_ring_at(ring, first + i);
         if (!s) {
@@ -659,40 +645,56 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (m < 3 || !(t_max > t_min)) {
         return GS_EINVAL;
     }
-    wn.ring = ring;
-    wn.first = first;
-    wn.count = count;
-    wn.m = m;
+    wn->ring = ring;
+    wn->first = first;
+    wn->count = count;
+    wn->m = m;
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
-    wn.t0_s = t_min + 0.5 * (t_max - t_min);
-    wn.tscale_s = t_max - t_min;
-    floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
+    wn->t0_s = t_min + 0.5 * (t_max - t_min);
+    wn->tscale_s = t_max - t_min;
+    return GS_OK;
+}
 
+static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, uint32_t *keep,
+                            gs_fit_result *out)
+{
+    gs_real floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
     switch (method) {
     case GS_FIT_PLAIN:
-        st = window_fit(&wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out);
-        break;
+        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out);
     case GS_FIT_IRLS:
-        st = fit_irls(&wn, m, floor_px, keep, out);
-        break;
+        return fit_irls(wn, wn->m, floor_px, keep, out);
     case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
-        st = GS_WITH_RANSAC ? fit_ransac(&wn, m, floor_px, keep, out) : GS_EINVAL;
-        break;
-    default:
-        st = GS_EINVAL;
-        break;
+        return GS_WITH_RANSAC ? fit_ransac(wn, wn->m, floor_px, keep, out) : GS_EINVAL;
+    }
+    return GS_EINVAL;
+}
+
+gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
+                        float min_scale_px, uint32_t *keep, gs_fit_result *out)
+{
+    gs_win wn;
+    uint32_t i;
+    gs_status st;
+    if (!out) {
+        return GS_EINVAL;
+    }
+    out->t0_s = (double)NAN;
+    out->n = 0;
+    nan_result(out);
+    if (!ring || !keep || count == 0) {
+        return GS_EINVAL;
+    }
+    st = win_open(&wn, ring, first, count);
+    if (st == GS_OK) {
+        st = fit_window(&wn, method, min_scale_px, keep, out);
     }
     if (st != GS_OK) {
         for (i = 0; i < count; i++) {
             keep_set(keep, i, false);
         }
-        return st;
     }
-    for (i = 0; i < count; i++) {
-        if (gs_fit_kept(keep, i)) {
-            n_pos++;
-        }
-    }
-    out->n = n_pos;
-    return GS_OK;
+    /* On success out->n already counts the kept samples: each window fit flags exactly
+     * the samples it adds, and the last one decides both. */
+    return st;
 }
