@@ -124,9 +124,16 @@ static void back_sub(const gs_real r[6], const gs_real z[3], gs_real c[3])
     c[0] = (z[0] - r[1] * c[1] - r[2] * c[2]) / r[0];
 }
 
-gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
+/* A parabola in tau for both axes: x = c[0] + c[1] tau + c[2] tau^2, y likewise in c[3..5]. */
+typedef struct {
+    gs_real c[6];
+} gs_par;
+
+/* gs_fit_solve, and on success the tau-basis parabola to *p (when p is not NULL). */
+static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
 {
-    gs_real cx[3], cy[3], col[3], ts, ts2, ssr;
+    gs_par par;
+    gs_real *cx = &par.c[0], *cy = &par.c[3], col[3], ts, ts2, ssr;
     int k;
     if (!f || !out) {
         return GS_EINVAL;
@@ -174,7 +181,15 @@ gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
         /* var(ax) = var(ay), so the magnitude's variance is the same. */
         out->a_se_px_s2 = GS_R(2.0) * se_c2 / ts2;
     }
+    if (p) {
+        *p = par;
+    }
     return GS_OK;
+}
+
+gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
+{
+    return solve_par(f, out, NULL);
 }
 
 const char *gs_fit_method_name(gs_fit_method m)
@@ -210,11 +225,6 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out)
 }
 
 /* ---- robust fits over a ring window ------------------------------------------ */
-
-/* A parabola in tau for both axes: x = c[0] + c[1] tau + c[2] tau^2, y likewise in c[3..5]. */
-typedef struct {
-    gs_real c[6];
-} gs_par;
 
 typedef struct {
     const gs_ring *ring;
@@ -396,7 +406,6 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
                             gs_par *p, gs_fit_result *out)
 {
     gs_fit f;
-    gs_status st;
     uint32_t i;
     fit_start(&f, wn->t0_s, wn->tscale_s);  /* both finite, the scale positive */
     for (i = 0; i < wn->count; i++) {
@@ -408,12 +417,7 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
             add_row(&f, s.tau, s.xy_px[0], s.xy_px[1], (gs_real)w);
         }
     }
-    st = gs_fit_solve(&f, out);
-    if (st == GS_OK && p) {
-        back_sub(f.r, f.zx, &p->c[0]);
-        back_sub(f.r, f.zy, &p->c[3]);
-    }
-    return st;
+    return solve_par(&f, out, p);
 }
 
 /* Index (into the window) of the k-th usable sample; count must cover it. */
