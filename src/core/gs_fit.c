@@ -6,6 +6,8 @@
 #include <string.h>
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
+#include "gs_dfinite.h"
+
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
 #define GS_FIT_SINGULAR_REL (sizeof(gs_real) < sizeof(double) ? GS_R(1e-5) : GS_R(1e-9))
@@ -26,26 +28,22 @@
 
 static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
+/* An empty fit at a valid centre and scale: all sums and R zero (all-zero bits are +0.0). */
+static void fit_start(gs_fit *f, double t0_s, double tscale_s)
+{
+    memset(f, 0, sizeof *f);
+    f->t0_s = t0_s;
+    f->tscale_s = tscale_s;
+}
+
 void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
 {
-    int k;
     if (!f) {
         return;
     }
-    f->t0_s = isfinite(t0_s) ? t0_s : 0.0;
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    f->tscale_s = (isfinite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0;
-    for (k = 0; k < 6; k++) {
-        f->r[k] = GS_R(0.0);
-    }
-    for (k = 0; k < 3; k++) {
-        f->zx[k] = GS_R(0.0);
-        f->zy[k] = GS_R(0.0);
-    }
-    f->ssr_x = GS_R(0.0);
-    f->ssr_y = GS_R(0.0);
-    f->sum_w = GS_R(0.0);
-    f->n = 0;
+    fit_start(f, gs_double_finite(t0_s) ? t0_s : 0.0,
+              (gs_double_finite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0);
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -55,21 +53,29 @@ static int rix(int i, int j)
     return base[i] + (j - i);
 }
 
-void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
+/* The centred, scaled time of an absolute time t_s (the fit's one double step). */
+static gs_real fit_tau(double t_s, double t0_s, double tscale_s)
 {
-    gs_real v[3], bx, by, sw, tau;
+    return (gs_real)((t_s - t0_s) / tscale_s);
+}
+
+/* Entry j of row k of the augmented factor [R | zx zy]: columns 0-2 are R's, 3 and 4 the right-hand sides. */
+static gs_real *aug_entry(gs_fit *f, int k, int j)
+{
+    return j < 3 ? &f->r[rix(k, j)] : j == 3 ? &f->zx[k] : &f->zy[k];
+}
+
+/* Rotate the weighted row (1, tau, tau^2 | x, y) into [R | zx zy]; w > 0 and all values finite. */
+static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real w)
+{
+    gs_real v[5], sw;
     int k, j;
-    if (!f || !(w > 0.0) || !isfinite(w) || !isfinite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
-        return;
-    }
     sw = sqrt((gs_real)w);
-    /* the one double step: an absolute time minus the fit's centre */
-    tau = (gs_real)((t_s - f->t0_s) / f->tscale_s);
     v[0] = sw;
     v[1] = sw * tau;
     v[2] = sw * tau * tau;
-    bx = sw * (gs_real)x_px;
-    by = sw * (gs_real)y_px;
+    v[3] = sw * (gs_real)x_px;
+    v[4] = sw * (gs_real)y_px;
     for (k = 0; k < 3; k++) {
         gs_real a = f->r[rix(k, k)];
         gs_real b = v[k];
@@ -80,25 +86,26 @@ void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
         rho = sqrt(a * a + b * b);
         c = a / rho;
         s = b / rho;
-        for (j = k; j < 3; j++) {
-            gs_real rkj = f->r[rix(k, j)];
-            f->r[rix(k, j)] = c * rkj + s * v[j];
+        for (j = k; j < 5; j++) {
+            gs_real *e = aug_entry(f, k, j);
+            gs_real rkj = *e;
+            *e = c * rkj + s * v[j];
             v[j] = c * v[j] - s * rkj;
-        }
-        {
-            gs_real zk = f->zx[k];
-            f->zx[k] = c * zk + s * bx;
-            bx = c * bx - s * zk;
-            zk = f->zy[k];
-            f->zy[k] = c * zk + s * by;
-            by = c * by - s * zk;
         }
     }
     /* What is left of the row after eliminating its basis part is its residual. */
-    f->ssr_x += bx * bx;
-    f->ssr_y += by * by;
+    f->ssr_x += v[3] * v[3];
+    f->ssr_y += v[4] * v[4];
     f->sum_w += (gs_real)w;
     f->n++;
+}
+
+void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
+{
+    if (!f || !(w > 0.0) || !isfinite(w) || !gs_double_finite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
+        return;
+    }
+    add_row(f, fit_tau(t_s, f->t0_s, f->tscale_s), x_px, y_px, w);
 }
 
 static void nan_result(gs_fit_result *out)
@@ -117,9 +124,16 @@ static void back_sub(const gs_real r[6], const gs_real z[3], gs_real c[3])
     c[0] = (z[0] - r[1] * c[1] - r[2] * c[2]) / r[0];
 }
 
-gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
+/* A parabola in tau for both axes: x = c[0] + c[1] tau + c[2] tau^2, y likewise in c[3..5]. */
+typedef struct {
+    gs_real c[6];
+} gs_par;
+
+/* gs_fit_solve, and on success the tau-basis parabola to *p (when p is not NULL). */
+static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
 {
-    gs_real cx[3], cy[3], col[3], ts, ts2, ssr;
+    gs_par par;
+    gs_real *cx = &par.c[0], *cy = &par.c[3], col[3], ts, ts2, ssr;
     int k;
     if (!f || !out) {
         return GS_EINVAL;
@@ -167,7 +181,15 @@ gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
         /* var(ax) = var(ay), so the magnitude's variance is the same. */
         out->a_se_px_s2 = GS_R(2.0) * se_c2 / ts2;
     }
+    if (p) {
+        *p = par;
+    }
     return GS_OK;
+}
+
+gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
+{
+    return solve_par(f, out, NULL);
 }
 
 const char *gs_fit_method_name(gs_fit_method m)
@@ -204,11 +226,6 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out)
 
 /* ---- robust fits over a ring window ------------------------------------------ */
 
-/* A parabola in tau for both axes: x = c[0] + c[1] tau + c[2] tau^2, y likewise in c[3..5]. */
-typedef struct {
-    gs_real c[6];
-} gs_par;
-
 typedef struct {
     const gs_ring *ring;
     uint64_t first;
@@ -233,29 +250,32 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
     return xorshift32(state) % n;
 }
 
-/* What a fit reads of a ring sample, unpacked. */
+/* What a fit reads of a usable ring sample, unpacked. */
 typedef struct {
-    double t_s;  /* absolute time: only differences from the window's centre leave double */
-    float x_px, y_px, w;
+    gs_real tau;    /* centred, scaled time in the window */
+    float xy_px[2]; /* x, y: indexed by axis like the parabola's coefficients */
+    float w;
 } gs_fsamp;
 
-/* Window sample i unpacked into *buf; NULL when the ring no longer holds it. */
-static const gs_fsamp *win_at(const gs_ring *ring, uint64_t idx, gs_fsamp *buf)
+/* A held sample with a weight and a position takes part in the fits. */
+static bool sample_usable(const gs_sample *s)
 {
-    const gs_sample *s = gs_ring_at(ring, idx);
-    if (!s) {
-        return NULL;
-    }
-    buf->t_s = gs_ring_sample_t_s(ring, s);
-    buf->x_px = s->x_px;
-    buf->y_px = s->y_px;
-    buf->w = gs_sample_w(s);
-    return buf;
+    return gs_sample_w(s) > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
 }
 
-static bool sample_usable(const gs_fsamp *s)
+/* Window sample i unpacked into *out when it is held and usable; false otherwise. */
+static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
 {
-    return s && s->w > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
+    const gs_sample *s = gs_ring_at(wn->ring, wn->first + i);
+    if (!s || !sample_usable(s)) {
+        return false;
+    }
+    /* absolute times meet in double; the centred, unit-length tau fits a float */
+    out->tau = fit_tau(gs_ring_sample_t_s(wn->ring, s), wn->t0_s, wn->tscale_s);
+    out->xy_px[0] = s->x_px;
+    out->xy_px[1] = s->y_px;
+    out->w = gs_sample_w(s);
+    return true;
 }
 
 bool gs_fit_kept(const uint32_t *keep, uint32_t i)
@@ -269,39 +289,34 @@ static void keep_set(uint32_t *keep, uint32_t i, bool on)
     keep[i >> 5] = on ? (keep[i >> 5] | bit) : (keep[i >> 5] & ~bit);
 }
 
-static gs_real win_tau(const gs_win *wn, const gs_fsamp *s)
-{
-    /* absolute times meet in double; the centred, unit-length tau fits a float */
-    return (gs_real)((s->t_s - wn->t0_s) / wn->tscale_s);
-}
-
 /* Squared 2D distance of a sample from the parabola, in px^2. */
-static gs_real resid2(const gs_par *p, gs_real tau, const gs_fsamp *s)
+static gs_real resid2(const gs_par *p, const gs_fsamp *s)
 {
-    gs_real ex = (gs_real)s->x_px - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
-    gs_real ey = (gs_real)s->y_px - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
+    gs_real tau = s->tau;
+    gs_real ex = (gs_real)s->xy_px[0] - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
+    gs_real ey = (gs_real)s->xy_px[1] - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
     return ex * ex + ey * ey;
 }
 
 /* 2D distance of a sample from the parabola, in px. */
-static gs_real resid_norm(const gs_par *p, gs_real tau, const gs_fsamp *s)
+static gs_real resid_norm(const gs_par *p, const gs_fsamp *s)
 {
-    return sqrt(resid2(p, tau, s));
+    return sqrt(resid2(p, s));
 }
 
 /* The parabola through three samples (Newton divided differences); false when two times coincide. */
-static bool par_through(const gs_win *wn, const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
+static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
 {
-    gs_real ta = win_tau(wn, a), tb = win_tau(wn, b), tc = win_tau(wn, c);
+    gs_real ta = a->tau, tb = b->tau, tc = c->tau;
     gs_real dab = tb - ta, dac = tc - ta, dbc = tc - tb;
-    int axis;
+    int axis, k;
     if (dab == GS_R(0.0) || dac == GS_R(0.0) || dbc == GS_R(0.0)) {
         return false;
     }
     for (axis = 0; axis < 2; axis++) {
-        gs_real va = axis ? a->y_px : a->x_px;
-        gs_real vb = axis ? b->y_px : b->x_px;
-        gs_real vc = axis ? c->y_px : c->x_px;
+        gs_real va = a->xy_px[axis];
+        gs_real vb = b->xy_px[axis];
+        gs_real vc = c->xy_px[axis];
         gs_real sab = (vb - va) / dab;
         gs_real sac = (vc - va) / dac;
         gs_real c2 = (sac - sab) / dbc;
@@ -310,7 +325,9 @@ static bool par_through(const gs_win *wn, const gs_fsamp *a, const gs_fsamp *b, 
         p->c[3 * axis + 0] = c0;
         p->c[3 * axis + 1] = c1;
         p->c[3 * axis + 2] = c2;
-        if (!isfinite(c0) || !isfinite(c1) || !isfinite(c2)) {
+    }
+    for (k = 0; k < 6; k++) {
+        if (!isfinite(p->c[k])) {
             return false;
         }
     }
@@ -334,11 +351,10 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
         uint32_t cnt[16] = {0};
         uint32_t d = 0;
         for (i = 0; i < wn->count; i++) {
-            gs_fsamp sb;
-            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
-            if (sample_usable(s)) {
+            gs_fsamp s;
+            if (win_usable(wn, i, &s)) {
                 /* squares order like norms: one sqrt for the median instead of one per sample */
-                float r2 = (float)resid2(p, win_tau(wn, s), s);
+                float r2 = (float)resid2(p, &s);
                 uint32_t key;
                 memcpy(&key, &r2, sizeof key);
                 if ((key & mask) == prefix) {
@@ -372,16 +388,13 @@ static gs_real tukey(gs_real r, gs_real cut)
 /* Final weight of one sample under a model: prior * robust factor, as a float. */
 typedef enum { W_PRIOR, W_TUKEY, W_INLIER } w_mode;
 
-static float sample_weight(const gs_win *wn, const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut)
+static float sample_weight(const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut)
 {
     gs_real r;
-    if (!sample_usable(s)) {
-        return 0.0f;
-    }
     if (mode == W_PRIOR) {
         return s->w;
     }
-    r = resid_norm(p, win_tau(wn, s), s);
+    r = resid_norm(p, s);
     if (mode == W_INLIER) {
         return r <= cut ? s->w : 0.0f;
     }
@@ -393,24 +406,18 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
                             gs_par *p, gs_fit_result *out)
 {
     gs_fit f;
-    gs_status st;
     uint32_t i;
-    gs_fit_init(&f, wn->t0_s, wn->tscale_s);
+    fit_start(&f, wn->t0_s, wn->tscale_s);  /* both finite, the scale positive */
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp sb;
-        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
-        float w = sample_weight(wn, s, model, mode, cut);
+        gs_fsamp s;
+        float w = win_usable(wn, i, &s) ? sample_weight(&s, model, mode, cut) : 0.0f;
         keep_set(keep, i, w > 0.0f);
         if (w > 0.0f) {
-            gs_fit_add(&f, s->t_s, s->x_px, s->y_px, (gs_real)w);
+            /* as gs_fit_add would: the fit shares the window's centre and scale */
+            add_row(&f, s.tau, s.xy_px[0], s.xy_px[1], (gs_real)w);
         }
     }
-    st = gs_fit_solve(&f, out);
-    if (st == GS_OK && p) {
-        back_sub(f.r, f.zx, &p->c[0]);
-        back_sub(f.r, f.zy, &p->c[3]);
-    }
-    return st;
+    return solve_par(&f, out, p);
 }
 
 /* Index (into the window) of the k-th usable sample; count must cover it. */
@@ -422,7 +429,7 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
     }
     for (i = 0; i < wn->count; i++) {
         gs_fsamp sb;
-        if (sample_usable(win_at(wn->ring, wn->first + i, &sb))) {
+        if (win_usable(wn, i, &sb)) {
             if (k == 0) {
                 return i;
             }
@@ -430,6 +437,17 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
         }
     }
     return wn->count - 1;
+}
+
+/* The parabola through the ka-th, kb-th and kc-th usable samples (par_through). */
+static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint32_t kc, gs_par *p)
+{
+    gs_fsamp a, b, c;
+    /* the window was checked to be held, and usable_index finds usable samples */
+    win_usable(wn, usable_index(wn, ka), &a);
+    win_usable(wn, usable_index(wn, kb), &b);
+    win_usable(wn, usable_index(wn, kc), &c);
+    return par_through(&a, &b, &c, p);
 }
 
 /* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
@@ -446,13 +464,9 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         uint32_t ka = rand_below(&state, third);
         uint32_t kb = third + rand_below(&state, third);
         uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
-        gs_fsamp ab, bb, cb;
-        const gs_fsamp *a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
-        const gs_fsamp *b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
-        const gs_fsamp *c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
         gs_par p;
         gs_real med;
-        if (!par_through(wn, a, b, c, &p)) {
+        if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
         med = median_resid(wn, &p);
@@ -485,33 +499,34 @@ static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
     return worst;
 }
 
-/* Tukey biweight IRLS from a start; *fin receives the converged curve. */
-static gs_status irls_from(const gs_win *wn, gs_par cur, gs_real floor_px, uint32_t *keep,
+/* Tukey biweight IRLS from a start; *fin (not start) receives the converged curve. */
+static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
                            gs_fit_result *out, gs_par *fin)
 {
     gs_par next;
     gs_real med, scale;
     int it;
     gs_status st;
+    bool settled;
+    *fin = *start;
     for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
-        med = median_resid(wn, &cur);
+        med = median_resid(wn, fin);
         /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
         scale = GS_FIT_MAD_K * med;
         if (!(scale >= floor_px)) {
             scale = floor_px;
         }
-        st = window_fit(wn, &cur, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
+        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
         if (st != GS_OK) {
             return st;
         }
         /* Settled when the curve moves by far less than the noise. */
-        if (par_max_shift_px(&cur, &next) <= GS_R(1e-6) * scale) {
-            cur = next;
+        settled = par_max_shift_px(fin, &next) <= GS_R(1e-6) * scale;
+        *fin = next;
+        if (settled) {
             break;
         }
-        cur = next;
     }
-    *fin = cur;
     return GS_OK;
 }
 
@@ -522,14 +537,13 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
     gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp sb;
-        const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+        gs_fsamp s;
         gs_real u;
-        if (!sample_usable(s)) {
+        if (!win_usable(wn, i, &s)) {
             continue;
         }
-        u = sqrt(resid2(p, win_tau(wn, s), s)) / cut;
-        loss += (gs_real)s->w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
+        u = sqrt(resid2(p, &s)) / cut;
+        loss += (gs_real)s.w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
     }
     return loss;
 }
@@ -539,26 +553,27 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
  * chance subset better than all of them): the smaller robust loss wins. */
 static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
 {
-    gs_par lms, plain, fin_lms, fin_plain;
-    gs_real med;
-    bool have_lms = lmeds_start(wn, m, &lms, &med);
-    bool have_plain = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &plain, out) == GS_OK;
-    gs_real loss_lms = (gs_real)INFINITY, loss_plain = (gs_real)INFINITY;
-    if (!have_lms && !have_plain) {
+    enum { LMS, PLAIN, N_STARTS };
+    gs_par start[N_STARTS], fin;
+    gs_real med, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
+    bool have[N_STARTS];
+    int k;
+    have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
+    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out) == GS_OK;
+    if (!have[LMS] && !have[PLAIN]) {
         return GS_EINVAL;
     }
-    if (have_lms && irls_from(wn, lms, floor_px, keep, out, &fin_lms) == GS_OK) {
-        loss_lms = tukey_loss(wn, &fin_lms, floor_px);
+    for (k = 0; k < N_STARTS; k++) {
+        if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
+            loss[k] = tukey_loss(wn, &fin, floor_px);
+        }
     }
-    if (have_plain && irls_from(wn, plain, floor_px, keep, out, &fin_plain) == GS_OK) {
-        loss_plain = tukey_loss(wn, &fin_plain, floor_px);
-    }
-    if (!(loss_plain <= loss_lms)) {
-        if (!(loss_lms < (gs_real)INFINITY)) {
+    if (!(loss[PLAIN] <= loss[LMS])) {
+        if (!(loss[LMS] < (gs_real)INFINITY)) {
             return GS_EINVAL;
         }
         /* the LMS run won: run it again so keep and out hold its weights */
-        return irls_from(wn, lms, floor_px, keep, out, &fin_lms);
+        return irls_from(wn, &start[LMS], floor_px, keep, out, &fin);
     }
     return GS_OK;
 }
@@ -575,28 +590,22 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
         uint32_t ka = rand_below(&state, m);
         uint32_t kb = rand_below(&state, m);
         uint32_t kc = rand_below(&state, m);
-        gs_fsamp ab, bb, cb;
-        const gs_fsamp *a, *b, *c;
         gs_par p;
         uint32_t n_in = 0;
         gs_real cost = GS_R(0.0);
         if (ka == kb || ka == kc || kb == kc) {
             continue;
         }
-        a = win_at(wn->ring, wn->first + usable_index(wn, ka), &ab);
-        b = win_at(wn->ring, wn->first + usable_index(wn, kb), &bb);
-        c = win_at(wn->ring, wn->first + usable_index(wn, kc), &cb);
-        if (!par_through(wn, a, b, c, &p)) {
+        if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
         for (i = 0; i < wn->count; i++) {
-            gs_fsamp sb;
-            const gs_fsamp *s = win_at(wn->ring, wn->first + i, &sb);
+            gs_fsamp s;
             gs_real r2;
-            if (!sample_usable(s)) {
+            if (!win_usable(wn, i, &s)) {
                 continue;
             }
-            r2 = resid2(&p, win_tau(wn, s), s);
+            r2 = resid2(&p, &s);
             if (r2 <= thr * thr) {
                 n_in++;
                 cost += r2;
@@ -616,13 +625,60 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
     return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out);
 }
 
+/* Opens the window [first, first+count): GS_EINVAL when a sample is no longer held
+ * or fewer than 3 usable ones at distinct times remain. */
+static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint32_t count)
+{
+    double t_min = 0.0, t_max = 0.0;  /* absolute times */
+    uint32_t i, m = 0;
+    for (i = 0; i < count; i++) {
+        const gs_sample *s = gs_ring_at(ring, first + i);
+        if (!s) {
+            /* Overwritten or not yet written: the window is gone. */
+            return GS_EINVAL;
+        }
+        if (sample_usable(s)) {
+            /* the ring's times never decrease: the first usable is the earliest, the last the latest */
+            t_max = gs_ring_sample_t_s(ring, s);
+            if (m == 0) {
+                t_min = t_max;
+            }
+            m++;
+        }
+    }
+    if (m < 3 || !(t_max > t_min)) {
+        return GS_EINVAL;
+    }
+    wn->ring = ring;
+    wn->first = first;
+    wn->count = count;
+    wn->m = m;
+    /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
+    wn->t0_s = t_min + 0.5 * (t_max - t_min);
+    wn->tscale_s = t_max - t_min;
+    return GS_OK;
+}
+
+static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, uint32_t *keep,
+                            gs_fit_result *out)
+{
+    gs_real floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
+    switch (method) {
+    case GS_FIT_PLAIN:
+        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out);
+    case GS_FIT_IRLS:
+        return fit_irls(wn, wn->m, floor_px, keep, out);
+    case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
+        return GS_WITH_RANSAC ? fit_ransac(wn, wn->m, floor_px, keep, out) : GS_EINVAL;
+    }
+    return GS_EINVAL;
+}
+
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
                         float min_scale_px, uint32_t *keep, gs_fit_result *out)
 {
     gs_win wn;
-    double t_min = (double)INFINITY, t_max = -(double)INFINITY;  /* absolute times */
-    gs_real floor_px;
-    uint32_t i, m = 0, n_pos = 0;
+    uint32_t i;
     gs_status st;
     if (!out) {
         return GS_EINVAL;
@@ -633,63 +689,16 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (!ring || !keep || count == 0) {
         return GS_EINVAL;
     }
-    for (i = 0; i < count; i++) {
-        keep_set(keep, i, false);
-    }
-    for (i = 0; i < count; i++) {
-        gs_fsamp sb;
-        const gs_fsamp *s = win_at(ring, first + i, &sb);
-        if (!s) {
-            /* Overwritten or not yet written: the window is gone. */
-            return GS_EINVAL;
-        }
-        if (sample_usable(s)) {
-            m++;
-            if (s->t_s < t_min) {
-                t_min = s->t_s;
-            }
-            if (s->t_s > t_max) {
-                t_max = s->t_s;
-            }
-        }
-    }
-    if (m < 3 || !(t_max > t_min)) {
-        return GS_EINVAL;
-    }
-    wn.ring = ring;
-    wn.first = first;
-    wn.count = count;
-    wn.m = m;
-    /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
-    wn.t0_s = t_min + 0.5 * (t_max - t_min);
-    wn.tscale_s = t_max - t_min;
-    floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
-
-    switch (method) {
-    case GS_FIT_PLAIN:
-        st = window_fit(&wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out);
-        break;
-    case GS_FIT_IRLS:
-        st = fit_irls(&wn, m, floor_px, keep, out);
-        break;
-    case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
-        st = GS_WITH_RANSAC ? fit_ransac(&wn, m, floor_px, keep, out) : GS_EINVAL;
-        break;
-    default:
-        st = GS_EINVAL;
-        break;
+    st = win_open(&wn, ring, first, count);
+    if (st == GS_OK) {
+        st = fit_window(&wn, method, min_scale_px, keep, out);
     }
     if (st != GS_OK) {
         for (i = 0; i < count; i++) {
             keep_set(keep, i, false);
         }
-        return st;
     }
-    for (i = 0; i < count; i++) {
-        if (gs_fit_kept(keep, i)) {
-            n_pos++;
-        }
-    }
-    out->n = n_pos;
-    return GS_OK;
+    /* On success out->n already counts the kept samples: each window fit flags exactly
+     * the samples it adds, and the last one decides both. */
+    return st;
 }

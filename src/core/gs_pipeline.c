@@ -5,6 +5,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_dfinite.h"
+
 #define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~((size_t)(a) - 1u))
 
 size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
@@ -13,6 +15,22 @@ size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
     size_t cap = cfg->ring_capacity;
     /* the ring, then one bit per ring slot for the robust fits' inlier flags */
     return ALIGN_UP(cap * sizeof(gs_sample), 8u) + ALIGN_UP((cap + 31u) / 32u * sizeof(uint32_t), 8u);
+}
+
+static void emit(gs_pipeline *p, const gs_event *ev)
+{
+    if (p->on_event) p->on_event(p->ctx, ev);
+}
+
+/* The aggregate as a GS_EV_HEIGHT or GS_EV_SUMMARY event of track. */
+static void emit_height(gs_pipeline *p, gs_event_type type, uint32_t track)
+{
+    gs_event h;
+    memset(&h, 0, sizeof h);
+    h.type = type;
+    gs_agg_get(&p->agg, &h.u.height);
+    h.u.height.track = track;
+    emit(p, &h);
 }
 
 /* Flight events pass through here: accepted jumps feed the aggregate, which
@@ -26,17 +44,12 @@ static void on_flight_event(void *ctx, const gs_event *ev)
         p->judge(p->judge_ctx, &judged.u.jump);
         ev = &judged;
     }
-    if (p->on_event) p->on_event(p->ctx, ev);
+    emit(p, ev);
     if (ev->type != GS_EV_JUMP) return;
     if (GS_WITH_POSE && p->sessions) gs_session_jump(&p->session, &ev->u.jump);
     if (ev->u.jump.accepted) {
         gs_agg_add(&p->agg, ev->u.jump.height_m, ev->u.jump.height_se_m);
-        gs_event h;
-        memset(&h, 0, sizeof h);
-        h.type = GS_EV_HEIGHT;
-        gs_agg_get(&p->agg, &h.u.height);
-        h.u.height.track = ev->u.jump.track;
-        if (p->on_event) p->on_event(p->ctx, &h);
+        emit_height(p, GS_EV_HEIGHT, ev->u.jump.track);
     } else {
         gs_agg_reject(&p->agg);
     }
@@ -92,7 +105,7 @@ static void emit_session(gs_pipeline *p, bool ended, const char *reason)
     memset(&h, 0, sizeof h);
     gs_agg_get(&p->agg, &h.u.height);
     gs_session_event(&p->session, ended, reason, &h.u.height, p->flight.track, &ev);
-    if (p->on_event) p->on_event(p->ctx, &ev);
+    emit(p, &ev);
 }
 
 /* A visit ends after a long absence or when someone else stands there; the
@@ -115,8 +128,8 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
 static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
 {
     if (p->finished) return GS_ESTATE;
-    if (!isfinite(s->t_s)) return GS_EINVAL;
-    if (isfinite(p->last_t_s)) {
+    if (!gs_double_finite(s->t_s)) return GS_EINVAL;
+    if (gs_double_finite(p->last_t_s)) {
         if (s->t_s < p->last_t_s) return GS_EORDER;
         if (s->t_s == p->last_t_s) return GS_OK;  /* a repeated frame carries nothing new */
     }
@@ -194,11 +207,6 @@ gs_status gs_pipeline_flush(gs_pipeline *p)
         emit_session(p, true, "end_of_stream");
         gs_session_close(&p->session);
     }
-    gs_event ev;
-    memset(&ev, 0, sizeof ev);
-    ev.type = GS_EV_SUMMARY;
-    gs_agg_get(&p->agg, &ev.u.height);
-    ev.u.height.track = p->flight.track;
-    if (p->on_event) p->on_event(p->ctx, &ev);
+    emit_height(p, GS_EV_SUMMARY, p->flight.track);
     return GS_OK;
 }

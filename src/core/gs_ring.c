@@ -4,6 +4,8 @@
 
 #include <math.h>
 
+#include "gs_dfinite.h"
+
 #define SIZE_FINE_Q 0x8000u      /* codes below: 1/16 px steps */
 #define SIZE_FINE_PX 2048.0f     /* ... up to here, then 1/4 px steps */
 #define SIZE_UNKNOWN 0xFFFFu
@@ -31,17 +33,19 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
 
 int64_t gs_ring_time_us(const gs_ring *r, double t_s)
 {
-    if (!r || !isfinite(t_s)) {
+    if (!r || !gs_double_finite(t_s)) {
         return INT64_MIN;
     }
     /* the first sample becomes the base; double because it is an absolute time */
-    double base = isfinite(r->t_base_s) ? r->t_base_s : t_s;
+    double base = gs_double_finite(r->t_base_s) ? r->t_base_s : t_s;
     double us = (t_s - base) * 1e6;
-    if (!(fabs(us) < TIME_MAX_US)) {
+    double mag_us = fabs(us);
+    if (!(mag_us < TIME_MAX_US)) {
         return INT64_MIN;
     }
-    /* round half away from zero without libm's llround */
-    return us >= 0.0 ? (int64_t)(us + 0.5) : -(int64_t)(-us + 0.5);
+    /* round half away from zero without libm's llround: the magnitude, then the sign */
+    int64_t n = (int64_t)(mag_us + 0.5);
+    return signbit(us) ? -n : n;
 }
 
 static uint16_t size_pack(float size_px)
@@ -121,7 +125,7 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     if (us == INT64_MIN) {
         return GS_EINVAL;
     }
-    bool first = !isfinite(r->t_base_s);
+    bool first = !gs_double_finite(r->t_base_s);
     if (!first && us < r->t_last_us) {
         return GS_EORDER;
     }
