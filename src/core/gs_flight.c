@@ -40,7 +40,7 @@
 /* ceil(x) of a double: libm's where gs_real is double, else the same value without
  * libm (only of finite |x| < 2^62: frame counts) */
 #define CEIL_D(x) (GS_REAL_IS_FLOAT ? ceil_d(x) : ceil(x))
-static double ceil_d(double x)
+static __attribute__((noinline)) double ceil_d(double x)
 {
     double t = (double)(long long)x;  /* toward zero, exact */
     return t < x ? t + 1.0 : t;
@@ -74,6 +74,14 @@ static double ceil_d(double x)
 #define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
+/* isfinite of a double by its exponent bits: the same answer without soft-float compares */
+static bool finite_d(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return ((uint32_t)(b >> 52) & 0x7ffu) != 0x7ffu;
+}
+
 static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
 {
     return gs_ring_get(f->ring, i, buf) ? buf : NULL;
@@ -90,7 +98,7 @@ static double t_at(const gs_flight *f, uint64_t i)
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
+    return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && finite_d(s->t_s);
 }
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
@@ -269,9 +277,9 @@ static gs_real cusum_step(gs_real S, gs_real z)
 }
 
 /* typical frame interval from the history (for time-based spans) */
-static double frame_dt(const gs_flight *f)
+static __attribute__((noinline)) double frame_dt(const gs_flight *f)
 {
-    return (isfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
+    return (finite_d(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
@@ -709,13 +717,13 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     while (in_lo < in_hi) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, in_lo, &s_b);
-        if (s && (!isfinite(T0) ? in_lo >= L : s->t_s > T0)) break;
+        if (s && (!finite_d(T0) ? in_lo >= L : s->t_s > T0)) break;
         in_lo++;
     }
     while (in_hi > in_lo) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, in_hi, &s_b);
-        if (s && (!isfinite(T1) ? in_hi <= R : s->t_s < T1)) break;
+        if (s && (!finite_d(T1) ? in_hi <= R : s->t_s < T1)) break;
         in_hi--;
     }
     f->up_x = save_ux;
@@ -739,8 +747,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        if (!s || !(s->w > 0.0f) || !isfinite(s->t_s)) continue;  /* frames missing from the source */
-        if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
+        if (!s || !(s->w > 0.0f) || !finite_d(s->t_s)) continue;  /* frames missing from the source */
+        if (finite_d(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
@@ -748,8 +756,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    if (!isfinite(T0)) T0 = sf->t_s - 0.5 * dt;
-    if (!isfinite(T1)) T1 = sl->t_s + 0.5 * dt;
+    if (!finite_d(T0)) T0 = sf->t_s - 0.5 * dt;
+    if (!finite_d(T1)) T1 = sl->t_s + 0.5 * dt;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -879,7 +887,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     if (IS_RIGID(f) || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
     if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
-    if (!isfinite(f->still_since)) f->still_since = s->t_s;
+    if (!finite_d(f->still_since)) f->still_since = s->t_s;
     if (s->upright >= LOOSE_UPRIGHT) {
         f->loose_size[f->loose_next] = s->size_px;
         f->loose_next = (f->loose_next + 1u) % GS_STAND_KEEP;
@@ -974,7 +982,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     update_standing(f, s, speed);
 
     /* recent minimum over two half-second blocks */
-    if (!isfinite(f->blk_t0)) f->blk_t0 = tm;
+    if (!finite_d(f->blk_t0)) f->blk_t0 = tm;
     if (tm - f->blk_t0 > 0.5) {
         f->blk_min_prev = f->blk_min_cur;
         f->blk_min_cur = INFINITY;
@@ -1087,13 +1095,13 @@ void gs_flight_update(gs_flight *f)
         const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
-        bool present = s && s->w > 0.0f && isfinite(s->t_s);
+        bool present = s && s->w > 0.0f && finite_d(s->t_s);
         if (present && !usable(s)) { f->last_t_s = s->t_s; continue; }
         if (!present) continue;
-        if (isfinite(f->last_t_s)) {
+        if (finite_d(f->last_t_s)) {
             double dt = s->t_s - f->last_t_s;
             if (dt > GS_R(0.0)) {
-                if (!isfinite(f->dt_med_s)) f->dt_med_s = dt;
+                if (!finite_d(f->dt_med_s)) f->dt_med_s = dt;
                 else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
             }
             if (dt > (double)f->cfg->max_gap_s) {
