@@ -103,11 +103,32 @@ static bool usable(const gs_sample_full *s)
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
 
-static bool usable_at(const gs_flight *f, uint64_t i)
+/* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side.
+ * The sign of a double difference is exact, so comparing it with 0 is comparing t with T. */
+static __attribute__((noinline)) double past_s(double t, double T, int side)
 {
-    gs_sample_full b;
-    return usable(at(f, i, &b));
+    double d = t - T;
+    return side < 0 ? -d : d;
 }
+
+/* Ring sample i unpacked into *buf when held and usable, else NULL. */
+static const gs_sample_full *usable_at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
+{
+    const gs_sample_full *s = at(f, i, buf);
+    return usable(s) ? s : NULL;
+}
+
+/* usable samples among [lo, hi] */
+static uint32_t count_usable(const gs_flight *f, uint64_t lo, uint64_t hi)
+{
+    uint32_t n = 0;
+    gs_sample_full b;
+    for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i, &b) ? 1u : 0u;
+    return n;
+}
+
+/* a measured size: positive and finite */
+static bool size_ok(float size_px) { return size_px > 0.0f && size_px < INFINITY; }
 
 static gs_real u_of(const gs_flight *f, const gs_sample_full *s)
 {
@@ -248,9 +269,9 @@ static gs_real pred_var_factor(const gs_fit *fit, double t_s)
  * outlier (bad keypoints: far off sideways or below the parabola); else *z is
  * the deviation against gravity in units of its standard deviation (contact
  * pushes the body above the parabola, so z grows quadratically after it). */
-static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
-                        const gs_sample_full *s, gs_real *z)
+static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sample_full *s, gs_real *z)
 {
+    const gs_fit *fit = &f->fit;
     /* per sample and per boundary candidate: gs_real; only the time difference is double */
     gs_real dt = (gs_real)(s->t_s - r->t0_s);
     gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
@@ -266,6 +287,14 @@ static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_resu
     gs_real tot = sig * GS_SQRT(GS_R(1.0) + (isfinite(vf) ? vf : GS_R(1e6)));
     *z = (gs_real)(up / tot);
     return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
+}
+
+/* Ring sample i when usable and no gross outlier against the fit r (its z in *z), else NULL. */
+static const gs_sample_full *tested_at(const gs_flight *f, const gs_fit_result *r, uint64_t i,
+                                       gs_sample_full *buf, gs_real *z)
+{
+    const gs_sample_full *s = usable_at(f, i, buf);
+    return s && test_sample(f, r, s, z) ? s : NULL;
 }
 
 /* one-sided CUSUM of z: contact raises it, noise drains it */
@@ -319,7 +348,8 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
     if (IS_RIGID(f)) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
-        return s && isfinite(s->size_px) ? (gs_real)s->size_px : NAN;
+        /* (a size of 0 gates as an unknown one: plausible_fall needs it positive) */
+        return s && size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
     }
     gs_real se;
     return stand_size(f, &se);
@@ -340,8 +370,8 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
     gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
-        if (usable(s) && gs_fit_kept(f->keep, (uint32_t)(i - lo))) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        const gs_sample_full *s = usable_at(f, i, &s_b);
+        if (s && gs_fit_kept(f->keep, (uint32_t)(i - lo))) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
     }
     gs_fit_result chk;
     return gs_fit_solve(&f->fit, &chk) == GS_OK;
@@ -360,13 +390,10 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     uint32_t checked = 0;
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
         gs_real z;
-        if (usable(s)) {
-            if (test_sample(f, &f->fit, &r, s, &z)) {
-                if (z > VERIFY_Z) return false;
-                checked++;
-            }
+        if (tested_at(f, &r, i, &s_b, &z)) {
+            if (z > VERIFY_Z) return false;
+            checked++;
         }
         if (side > 0) { if (i == lo) break; i--; } else { if (i == hi) break; i++; }
     }
@@ -384,16 +411,13 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     if (lo < oldest) lo = oldest;
     /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
-        uint32_t n = 0;
-        for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i) ? 1u : 0u;
-        if (n >= 5) break;
+        if (count_usable(f, lo, hi) >= 5) break;
         if (lo > f->quiet_from && lo > oldest) lo--;
         if (hi < newest) hi++;
     }
     if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
-    uint32_t n_usable = 0;
-    for (uint64_t i = lo; i <= hi; i++) n_usable += usable_at(f, i) ? 1u : 0u;
+    uint32_t n_usable = count_usable(f, lo, hi);
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
@@ -468,12 +492,12 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
     gs_real ts2 = (gs_real)(ts * ts);
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
         gs_real z;
-        if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
+        const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
+        if (!s) continue;  /* gross outliers out */
         gs_real w = (gs_real)s->w;
         gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
-        gs_real d = (gs_real)(side < 0 ? (T - s->t_s) : (s->t_s - T));
+        gs_real d = (gs_real)past_s(s->t_s, T, side);
         gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
         gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
@@ -504,12 +528,14 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
     return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
 }
 
-/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples. */
-static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
-                              uint64_t edge_in, uint64_t edge_out, gs_real alpha_min_px,
-                              gs_real alpha_max_px, double t_grown, gs_real penalty,
+/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
+ * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
+static __attribute__((noinline)) double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
+                              uint64_t edge_in, uint64_t edge_out, gs_real penalty,
                               const gs_fit_result *r)
 {
+    gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
+    gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
     gs_sample_full a_b, b_b;
     const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
     gs_sample_full ei_b, eo_b;
@@ -531,7 +557,7 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
         double T = t_from + (t_to - t_from) * (double)k / (double)steps;
         gs_real ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
         /* dropping samples the online test took as flight must pay for itself */
-        if ((side < 0 && T > t_grown) || (side > 0 && T < t_grown)) ssr += penalty;
+        if (past_s(T, ei->t_s, side) < 0.0) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
@@ -573,7 +599,7 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
     for (uint64_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        if (s && isfinite(s->size_px) && s->size_px > 0.0f) v[n++] = s->size_px;
+        if (s && size_ok(s->size_px)) v[n++] = s->size_px;
     }
     return median_se(v, n, se_out);
 }
@@ -607,7 +633,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         if (sd && sd->t_s - s->t_s > (double)f->cfg->max_flight_s) break;
         t_prev = s->t_s;
         gs_real z;
-        if (!test_sample(f, &f->fit, r, s, &z)) {
+        if (!test_sample(f, r, s, &z)) {
             if (++outl > 2) break;
             continue;
         }
@@ -640,7 +666,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
  * deviation against gravity keeps growing, as under a constant contact force
  * (after an impact the body soon stops following it). Returns how many;
  * *outer = the outermost, *first = the nearest. */
-static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
+static __attribute__((noinline)) uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
                             uint64_t *outer, uint64_t *first)
 {
     uint64_t oldest = gs_ring_oldest(f->ring);
@@ -655,10 +681,8 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
         if (side < 0) { if (i <= floor_idx) break; i--; }
         else { if (i + 1 >= head) break; i++; }
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
-        if (!usable(s)) continue;
         gs_real z;
-        if (!test_sample(f, &f->fit, r, s, &z)) continue;  /* a glitch: look past it */
+        if (!tested_at(f, r, i, &s_b, &z)) continue;  /* a glitch: look past it */
         if (n > 0 && !(z > z_prev)) break;
         if (n == 0) *first = i;
         *outer = i;
@@ -666,6 +690,17 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
         n++;
     }
     return n;
+}
+
+/* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
+ * not beyond the grown edge? (false when not held) */
+static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
+{
+    gs_sample_full s_b;
+    const gs_sample_full *s = at(f, i, &s_b);
+    if (!s) return false;
+    if (!finite_d(T)) return side < 0 ? i >= edge : i <= edge;
+    return past_s(s->t_s, T, side) < 0.0;
 }
 
 /* Close the open candidate. right_alarm: the sample at which contact was
@@ -693,20 +728,20 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     if (left_alarm != UINT64_MAX) n_left = contact_run(f, &r, L, -1, &lo, &first_left);
     if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
     double T0 = NAN, T1 = NAN;
-    /* a flight longer than the ring holds has lost its edges: no refinement */
-    if (!held(f, L) || !held(f, R) || !held(f, lo) || !held(f, hi) || !held(f, first_left) || !held(f, first_right))
+    /* a flight longer than the ring holds has lost its edges: no refinement (the ring
+     * holds a contiguous range and lo <= first_left <= L <= R <= first_right <= hi) */
+    if (!held(f, lo) || !held(f, hi))
         n_left = n_right = 0;
-    gs_real amin = CONTACT_MIN_G * r.a_px_s2;
     gs_real sig = fit_sigma(f, &r);
     gs_real pen = DROP_PENALTY * sig * sig;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n_left >= 2)
-        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, t_at(f, L), pen, &r);
+        T0 = refine_boundary(f, lo, R, -1, L, lo, pen, &r);
     else if (n_left == 1)
         T0 = 0.5 * (t_at(f, first_left) + t_at(f, L));
     if (n_right >= 2)
-        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, t_at(f, R), pen, &r);
+        T1 = refine_boundary(f, L, hi, +1, R, hi, pen, &r);
     else if (n_right == 1)
         T1 = 0.5 * (t_at(f, first_right) + t_at(f, R));
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
@@ -714,18 +749,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         n_left, n_right, T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
     uint64_t in_lo = lo, in_hi = hi;
-    while (in_lo < in_hi) {
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, in_lo, &s_b);
-        if (s && (!finite_d(T0) ? in_lo >= L : s->t_s > T0)) break;
-        in_lo++;
-    }
-    while (in_hi > in_lo) {
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, in_hi, &s_b);
-        if (s && (!finite_d(T1) ? in_hi <= R : s->t_s < T1)) break;
-        in_hi--;
-    }
+    while (in_lo < in_hi && !inside_edge(f, in_lo, T0, -1, L)) in_lo++;
+    while (in_hi > in_lo && !inside_edge(f, in_hi, T1, +1, R)) in_hi--;
     f->up_x = save_ux;
     f->up_y = save_uy;
 
@@ -739,6 +764,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
                                  f->keep, &fr);
     trace_fit(f, "final", sf->t_s, sl->t_s, st == GS_OK ? &fr : NULL);
+    if (st != GS_OK) goto done;  /* nothing fits: not a flight worth reporting */
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
@@ -752,7 +778,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
-        if (st == GS_OK && !gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
+        if (!gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
@@ -770,19 +796,13 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     j->flight_time_s = T1 - T0;
     j->n_samples = n_in;
     j->n_outliers = n_out;
-    j->a_px_s2 = j->a_px_se_s2 = j->g_dir_deg = j->q_m_per_px = NAN;
-    j->size_px = j->height_m = j->height_se_m = NAN;
-    j->jump_height_m = j->takeoff_velocity_m_s = j->t_apex_s = j->rms_px = NAN;
-    j->accepted = false;
-    j->reason = GS_REJ_NONE;
+    j->height_m = j->height_se_m = NAN;  /* the other fields are all set below (memset: not accepted, no reason) */
 
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
 
-    if (st != GS_OK) {
-        goto done;  /* nothing fits: not a flight worth reporting */
-    } else {
+    {
         gs_real g = f->g_m_s2;
         j->a_px_s2 = fr.a_px_s2;
         j->a_px_se_s2 = fr.a_se_px_s2;
@@ -876,28 +896,32 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
-    const gs_sample_full *b = at(f, idx - k, &b_b);
-    if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
+    const gs_sample_full *b = usable_at(f, idx - k, &b_b);
+    if (!b || !(s->t_s > b->t_s)) return NAN;
     return GS_FABSR(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
+}
+
+/* keep size in a ring of the last GS_STAND_KEEP */
+static __attribute__((noinline)) void keep_size(float *ring, uint32_t *n, uint32_t *next, float size_px)
+{
+    ring[*next] = size_px;
+    *next = (*next + 1u) % GS_STAND_KEEP;
+    if (*n < GS_STAND_KEEP) (*n)++;
 }
 
 static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed)
 {
     if (!isfinite(speed)) return;
-    if (IS_RIGID(f) || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
+    if (IS_RIGID(f) || !size_ok(s->size_px)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
     if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
     if (!finite_d(f->still_since)) f->still_since = s->t_s;
     if (s->upright >= LOOSE_UPRIGHT) {
-        f->loose_size[f->loose_next] = s->size_px;
-        f->loose_next = (f->loose_next + 1u) % GS_STAND_KEEP;
-        if (f->loose_n < GS_STAND_KEEP) f->loose_n++;
+        keep_size(f->loose_size, &f->loose_n, &f->loose_next, s->size_px);
     }
     if (!(s->upright >= STAND_UPRIGHT)) return;
     if (s->t_s - f->still_since < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
-    f->stand_size[f->stand_next] = s->size_px;
-    f->stand_next = (f->stand_next + 1u) % GS_STAND_KEEP;
-    if (f->stand_n < GS_STAND_KEEP) f->stand_n++;
+    keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_t = s->t_s;
     /* body axis -> image up, until flights measure gravity directly */
     if (!f->up_from_flight && isfinite(s->up_x) && isfinite(s->up_y)) {
@@ -934,7 +958,7 @@ static gs_real size_ref(const gs_flight *f, const gs_sample_full *s)
         uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
         return f->stand_size[i];
     }
-    return (isfinite(s->size_px) && s->size_px > 0.0f) ? (gs_real)s->size_px : NAN;
+    return size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
 }
 
 static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
@@ -962,7 +986,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
      * jump series would otherwise pass for noise) */
     gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
     /* size_ref(f, s) again would be sz: nothing between changes what it reads */
-    bool still = isfinite(speed) && (!isfinite(sz) || speed < STAND_SPEED_REL * sz);
+    /* sz is positive or NaN (unknown: any finite speed counts) */
+    bool still = isfinite(speed) && !(speed >= STAND_SPEED_REL * sz);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
@@ -993,7 +1018,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 
     gs_real nz = noise_floor(f);
     gs_real thr = SEED_RISE_NOISE * nz;
-    if (isfinite(sz) && SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;
+    if (SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;  /* false for an unknown (NaN) size */
     DBG("g t=%.3f um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", tm, um, umin, thr, nz, sz, f->peak_u);
     /* a peak counts once it rose thr above the recent minimum; the drop that
      * confirms it as an apex seeds a flight, however far it has fallen by then */
@@ -1003,7 +1028,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     }
     if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; return; }
     gs_real drop = SEED_DROP_NOISE * nz;
-    if (isfinite(sz) && GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
+    if (GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
     if (f->peak_u - um <= drop) return;
     uint64_t apex = f->peak_idx;
     double apex_t = f->peak_t;
@@ -1013,8 +1038,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         /* samples after the core that arrived meanwhile are tested in order */
         for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
             gs_sample_full p_b;
-            const gs_sample_full *p = at(f, i, &p_b);
-            if (usable(p)) airborne_sample(f, i, p);
+            const gs_sample_full *p = usable_at(f, i, &p_b);
+            if (p) airborne_sample(f, i, p);
         }
     }
 }
@@ -1045,7 +1070,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     uint64_t k = idx - f->fl_last - 1;  /* position among the pending samples */
     if (k >= 32) { land(f, idx, UINT64_MAX, s); return; }
     gs_real z;
-    bool ok = test_sample(f, &f->fit, &r, s, &z);
+    bool ok = test_sample(f, &r, s, &z);
     DBG("t=%.4f ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", s->t_s, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
         if (++f->outliers_run >= 3) land(f, idx, UINT64_MAX, s);
@@ -1075,8 +1100,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         /* everything pending was flight after all: take it in */
         for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
             gs_sample_full p_b;
-            const gs_sample_full *p = at(f, j, &p_b);
-            if (usable(p) && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
+            const gs_sample_full *p = usable_at(f, j, &p_b);
+            if (p && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
                 gs_fit_add(&f->fit, p->t_s, p->x_px, p->y_px, p->w);
         }
         f->fl_last = idx;
