@@ -37,10 +37,13 @@
 #define DBG(...) ((void)0)
 #endif
 
+/* small helpers called from several places: one copy is smaller than inlining it everywhere */
+#define NOINLINE __attribute__((noinline))
+
 /* ceil(x) of a double: libm's where gs_real is double, else the same value without
  * libm (only of finite |x| < 2^62: frame counts) */
 #define CEIL_D(x) (GS_REAL_IS_FLOAT ? ceil_d(x) : ceil(x))
-static __attribute__((noinline)) double ceil_d(double x)
+static NOINLINE double ceil_d(double x)
 {
     double t = (double)(long long)x;  /* toward zero, exact */
     return t < x ? t + 1.0 : t;
@@ -103,9 +106,15 @@ static bool usable(const gs_sample_full *s)
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
 
+/* t1 - t0 longer than a configured span (false when either time is NaN) */
+static NOINLINE bool span_over(double t1, double t0, float span_s)
+{
+    return t1 - t0 > (double)span_s;
+}
+
 /* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side.
  * The sign of a double difference is exact, so comparing it with 0 is comparing t with T. */
-static __attribute__((noinline)) double past_s(double t, double T, int side)
+static NOINLINE double past_s(double t, double T, int side)
 {
     double d = t - T;
     return side < 0 ? -d : d;
@@ -119,7 +128,7 @@ static const gs_sample_full *usable_at(const gs_flight *f, uint64_t i, gs_sample
 }
 
 /* usable samples among [lo, hi] */
-static uint32_t count_usable(const gs_flight *f, uint64_t lo, uint64_t hi)
+static NOINLINE uint32_t count_usable(const gs_flight *f, uint64_t lo, uint64_t hi)
 {
     uint32_t n = 0;
     gs_sample_full b;
@@ -128,9 +137,9 @@ static uint32_t count_usable(const gs_flight *f, uint64_t lo, uint64_t hi)
 }
 
 /* a measured size: positive and finite */
-static bool size_ok(float size_px) { return size_px > 0.0f && size_px < INFINITY; }
+static NOINLINE bool size_ok(float size_px) { return size_px > 0.0f && size_px < INFINITY; }
 
-static gs_real u_of(const gs_flight *f, const gs_sample_full *s)
+static NOINLINE gs_real u_of(const gs_flight *f, const gs_sample_full *s)
 {
     return (gs_real)s->x_px * f->up_x + (gs_real)s->y_px * f->up_y;
 }
@@ -150,7 +159,7 @@ const char *gs_flight_state_name(gs_flight_state s)
     return "?";
 }
 
-static void set_state(gs_flight *f, gs_flight_state to, double t_s)
+static NOINLINE void set_state(gs_flight *f, gs_flight_state to, double t_s)
 {
     if (f->state == to) return;
     if (GS_WITH_TRACE && f->trace) {
@@ -298,7 +307,7 @@ static const gs_sample_full *tested_at(const gs_flight *f, const gs_fit_result *
 }
 
 /* one-sided CUSUM of z: contact raises it, noise drains it */
-static gs_real cusum_step(gs_real S, gs_real z)
+static NOINLINE gs_real cusum_step(gs_real S, gs_real z)
 {
     if (z > CUSUM_ZMAX) z = CUSUM_ZMAX;
     S += z - CUSUM_K;
@@ -306,7 +315,7 @@ static gs_real cusum_step(gs_real S, gs_real z)
 }
 
 /* typical frame interval from the history (for time-based spans) */
-static __attribute__((noinline)) double frame_dt(const gs_flight *f)
+static NOINLINE double frame_dt(const gs_flight *f)
 {
     return (finite_d(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
 }
@@ -358,16 +367,15 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
 /* Rebuild the running fit robustly from the ring samples [lo, hi]. */
 static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
 {
-    gs_sample_full a_b, b_b;
-    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
-    if (!a || !b || hi <= lo) return false;
+    double t_lo = t_at(f, lo), t_hi = t_at(f, hi);
+    if (!finite_d(t_lo) || !finite_d(t_hi) || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     gs_fit_result r;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, &r) != GS_OK)
         return false;
-    double tspan = b->t_s - a->t_s;
-    gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
+    double tspan = t_hi - t_lo;
+    gs_fit_init(&f->fit, 0.5 * (t_lo + t_hi), tspan > 0.0 ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = usable_at(f, i, &s_b);
@@ -530,23 +538,20 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
  * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
-static __attribute__((noinline)) double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
+static NOINLINE double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
                               uint64_t edge_in, uint64_t edge_out, gs_real penalty,
                               const gs_fit_result *r)
 {
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
     gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
-    gs_sample_full a_b, b_b;
-    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
-    gs_sample_full ei_b, eo_b;
-    const gs_sample_full *ei = at(f, edge_in, &ei_b), *eo = at(f, edge_out, &eo_b);
-    if (!a || !b || !ei || !eo) return NAN;
-    double tc = 0.5 * (a->t_s + b->t_s), ts = 0.5 * (b->t_s - a->t_s);
+    double t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
+    if (!finite_d(t_lo) || !finite_d(t_hi) || !finite_d(t_in) || !finite_d(t_out)) return NAN;
+    double tc = 0.5 * (t_lo + t_hi), ts = 0.5 * (t_hi - t_lo);
     if (!(ts > 0.0)) return NAN;
     /* search between the outermost contact sample and a little inside the flight */
     double dt = frame_dt(f);
     double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
-    double t_from = eo->t_s, t_to = ei->t_s + (side < 0 ? inside : -inside);
+    double t_from = t_out, t_to = t_in + (side < 0 ? inside : -inside);
     if (side > 0) { double tmp = t_from; t_from = t_to; t_to = tmp; }
     int steps = (int)CEIL_D((t_to - t_from) / dt * BOUNDARY_STEPS);
     if (steps < 1) steps = 1;
@@ -557,7 +562,7 @@ static __attribute__((noinline)) double refine_boundary(const gs_flight *f, uint
         double T = t_from + (t_to - t_from) * (double)k / (double)steps;
         gs_real ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
         /* dropping samples the online test took as flight must pay for itself */
-        if (past_s(T, ei->t_s, side) < 0.0) ssr += penalty;
+        if (past_s(T, t_in, side) < 0.0) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
@@ -611,16 +616,12 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
 static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
 {
     uint64_t alarm = UINT64_MAX;
-    double max_gap = (double)f->cfg->max_gap_s;
     uint32_t outl = 0;
     gs_real S = GS_R(0.0);
     uint64_t oldest = gs_ring_oldest(f->ring);
     uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
-    gs_sample_full first_b;
-    const gs_sample_full *first = at(f, f->fl_first, &first_b);
-    double t_prev = first ? first->t_s : NAN;
-    gs_sample_full sd_b;
-    const gs_sample_full *sd = at(f, f->seed_idx, &sd_b);
+    double t_prev = t_at(f, f->fl_first);
+    double t_seed = t_at(f, f->seed_idx);
     uint64_t clean = f->fl_first;
     uint64_t i = f->fl_first;
     while (i > floor_idx) {
@@ -629,8 +630,8 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s) break;
         if (!usable(s)) continue;
-        if (t_prev - s->t_s > max_gap) break;
-        if (sd && sd->t_s - s->t_s > (double)f->cfg->max_flight_s) break;
+        if (span_over(t_prev, s->t_s, f->cfg->max_gap_s)) break;
+        if (span_over(t_seed, s->t_s, f->cfg->max_flight_s)) break;
         t_prev = s->t_s;
         gs_real z;
         if (!test_sample(f, r, s, &z)) {
@@ -666,7 +667,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
  * deviation against gravity keeps growing, as under a constant contact force
  * (after an impact the body soon stops following it). Returns how many;
  * *outer = the outermost, *first = the nearest. */
-static __attribute__((noinline)) uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
+static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
                             uint64_t *outer, uint64_t *first)
 {
     uint64_t oldest = gs_ring_oldest(f->ring);
@@ -694,13 +695,23 @@ static __attribute__((noinline)) uint32_t contact_run(const gs_flight *f, const 
 
 /* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
  * not beyond the grown edge? (false when not held) */
-static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
+static NOINLINE bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
 {
     gs_sample_full s_b;
     const gs_sample_full *s = at(f, i, &s_b);
     if (!s) return false;
     if (!finite_d(T)) return side < 0 ? i >= edge : i <= edge;
     return past_s(s->t_s, T, side) < 0.0;
+}
+
+/* Restart the seed's level trackers from level u at time t_s (NaN: none) */
+static NOINLINE void restart_levels(gs_flight *f, gs_real u, double t_s)
+{
+    f->blk_min_cur = isfinite(u) ? u : INFINITY;
+    f->blk_min_prev = f->blk_min_cur;
+    f->blk_t0 = t_s;
+    f->peak_u = -INFINITY;
+    f->n_hist = 0;
 }
 
 /* Close the open candidate. right_alarm: the sample at which contact was
@@ -876,12 +887,7 @@ done:
         /* next seeds start after the landing: restart the level trackers */
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, newest, &s_b);
-        gs_real u = s ? u_of(f, s) : NAN;
-        f->blk_min_cur = isfinite(u) ? u : INFINITY;
-        f->blk_min_prev = f->blk_min_cur;
-        f->blk_t0 = s ? s->t_s : NAN;
-        f->peak_u = -INFINITY;
-        f->n_hist = 0;
+        restart_levels(f, s ? u_of(f, s) : NAN, s ? s->t_s : NAN);
     }
 }
 
@@ -902,7 +908,7 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
 }
 
 /* keep size in a ring of the last GS_STAND_KEEP */
-static __attribute__((noinline)) void keep_size(float *ring, uint32_t *n, uint32_t *next, float size_px)
+static NOINLINE void keep_size(float *ring, uint32_t *n, uint32_t *next, float size_px)
 {
     ring[*next] = size_px;
     *next = (*next + 1u) % GS_STAND_KEEP;
@@ -1056,10 +1062,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
-    gs_sample_full seed_b;
-    const gs_sample_full *seed = at(f, f->seed_idx, &seed_b);
-    if (gs_fit_solve(&f->fit, &r) != GS_OK ||
-        (seed && s->t_s - seed->t_s > (double)f->cfg->max_flight_s)) {
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_s, t_at(f, f->seed_idx), f->cfg->max_flight_s)) {
         land(f, idx, UINT64_MAX, s);
         return;
     }
@@ -1079,9 +1082,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    gs_sample_full edge_b;
-    const gs_sample_full *edge = at(f, f->fl_last, &edge_b);
-    if (f->cusum > GS_R(0.0) && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
+    if (f->cusum > GS_R(0.0) && span_over(s->t_s, t_at(f, f->fl_last), f->cfg->landing_latency_s)) {
         land(f, idx, idx, s);
         return;
     }
@@ -1133,10 +1134,7 @@ void gs_flight_update(gs_flight *f)
                 if (f->state == GS_FS_AIRBORNE) {
                     close_candidate(f, f->last_idx, UINT64_MAX, true);
                 }
-                f->n_hist = 0;
-                f->peak_u = -INFINITY;
-                f->blk_min_cur = f->blk_min_prev = INFINITY;
-                f->blk_t0 = NAN;
+                restart_levels(f, NAN, NAN);
                 set_state(f, GS_FS_GROUND, s->t_s);
             }
         }
