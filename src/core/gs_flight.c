@@ -76,6 +76,9 @@ static NOINLINE double ceil_d(double x)
 #define STAND_SETTLE_S   0.2          /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
+/* isfinite of a gs_real (or float) value, in one place */
+static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
+
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 /* isfinite of a double by its exponent bits: the same answer without soft-float compares */
 static bool finite_d(double x)
@@ -101,7 +104,7 @@ static double t_at(const gs_flight *f, uint64_t i)
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && finite_d(s->t_s);
+    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px) && finite_d(s->t_s);
 }
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
@@ -246,7 +249,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
 
 static gs_real noise_floor(const gs_flight *f)
 {
-    gs_real n = isfinite(f->noise_px) ? f->noise_px : GS_R(1.0);
+    gs_real n = finite_r(f->noise_px) ? f->noise_px : GS_R(1.0);
     return n > GS_R(0.05) ? n : GS_R(0.05);
 }
 
@@ -254,7 +257,7 @@ static gs_real noise_floor(const gs_flight *f)
 static gs_real fit_sigma(const gs_flight *f, const gs_fit_result *r)
 {
     gs_real s = noise_floor(f);
-    if (r->n >= 8 && isfinite(r->rms_px)) {
+    if (r->n >= 8 && finite_r(r->rms_px)) {
         gs_real sf = r->rms_px / GS_SQRT(GS_R(2.0)) * GS_SQRT((gs_real)r->n / (gs_real)(r->n - 3));
         if (sf > s) s = sf;
     }
@@ -288,12 +291,12 @@ static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sam
     gs_real py = (gs_real)r->y0_px + (gs_real)r->vy_px_s * dt + GS_R(0.5) * ay * dt * dt;
     gs_real ex = (gs_real)s->x_px - px, ey = (gs_real)s->y_px - py;
     gs_real gx = ax / a, gy = ay / a;
-    if (!isfinite(gx) || !isfinite(gy)) { gx = (gs_real)-f->up_x; gy = (gs_real)-f->up_y; }
+    if (!finite_r(gx) || !finite_r(gy)) { gx = (gs_real)-f->up_x; gy = (gs_real)-f->up_y; }
     gs_real up = -(ex * gx + ey * gy);
     gs_real perp = ex * (-gy) + ey * gx;
     gs_real sig = (gs_real)fit_sigma(f, r);
     gs_real vf = pred_var_factor(fit, s->t_s);
-    gs_real tot = sig * GS_SQRT(GS_R(1.0) + (isfinite(vf) ? vf : GS_R(1e6)));
+    gs_real tot = sig * GS_SQRT(GS_R(1.0) + (finite_r(vf) ? vf : GS_R(1e6)));
     *z = (gs_real)(up / tot);
     return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
 }
@@ -332,7 +335,7 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
 {
     if (!(r->a_px_s2 > GS_R(0.0))) return false;
     /* a fit of few noisy samples gets the benefit of two standard errors */
-    gs_real rel_se = (isfinite(r->a_se_px_s2) && r->a_se_px_s2 > GS_R(0.0)) ? r->a_se_px_s2 / r->a_px_s2 : GS_R(0.0);
+    gs_real rel_se = (finite_r(r->a_se_px_s2) && r->a_se_px_s2 > GS_R(0.0)) ? r->a_se_px_s2 / r->a_px_s2 : GS_R(0.0);
     gs_real cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
     gs_real max_ang = f->up_from_flight ? GS_R(25.0) : (f->up_n > 0 ? GS_R(40.0) : GS_R(60.0));
     max_ang += GS_R(2.0) * rel_se * GS_R(180.0) / GS_PI;
@@ -340,15 +343,16 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
     /* a threshold: single precision is plenty where double is emulated */
     if (!(cosang > (gs_real)GS_COS(max_ang * GS_PI / GS_R(180.0)))) return false;
     gs_real a_hi = r->a_px_s2 + GS_R(2.0) * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - GS_R(2.0) * rel_se * r->a_px_s2;
-    if (isfinite(size_px) && size_px > GS_R(0.0)) {
+    gs_real a_min = -(gs_real)INFINITY, a_max = (gs_real)INFINITY;  /* no size, no flight yet: any */
+    if (finite_r(size_px) && size_px > GS_R(0.0)) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
-        gs_real a_min = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_max_m * EMIT_FACTOR);
-        gs_real a_max = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_min_m / EMIT_FACTOR);
-        if (a_hi < a_min || a_lo > a_max) return false;
-    } else if (isfinite(f->last_a_px_s2)) {
-        if (a_hi < f->last_a_px_s2 / EMIT_FACTOR || a_lo > f->last_a_px_s2 * EMIT_FACTOR) return false;
+        a_min = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_max_m * EMIT_FACTOR);
+        a_max = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_min_m / EMIT_FACTOR);
+    } else if (finite_r(f->last_a_px_s2)) {
+        a_min = f->last_a_px_s2 / EMIT_FACTOR;
+        a_max = f->last_a_px_s2 * EMIT_FACTOR;
     }
-    return true;
+    return !(a_hi < a_min || a_lo > a_max);
 }
 
 /* the object's size in px for gating: standing stature, or the rigid object's latest size */
@@ -362,6 +366,12 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
     }
     gs_real se;
     return stand_size(f, &se);
+}
+
+/* sample s into the running fit */
+static NOINLINE void fit_add(gs_flight *f, const gs_sample_full *s)
+{
+    gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
 }
 
 /* Rebuild the running fit robustly from the ring samples [lo, hi]. */
@@ -379,7 +389,7 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = usable_at(f, i, &s_b);
-        if (s && gs_fit_kept(f->keep, (uint32_t)(i - lo))) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        if (s && gs_fit_kept(f->keep, (uint32_t)(i - lo))) fit_add(f, s);
     }
     gs_fit_result chk;
     return gs_fit_solve(&f->fit, &chk) == GS_OK;
@@ -538,7 +548,7 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
  * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
-static NOINLINE double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
+static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
                               uint64_t edge_in, uint64_t edge_out, gs_real penalty,
                               const gs_fit_result *r)
 {
@@ -609,6 +619,13 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
     return median_se(v, n, se_out);
 }
 
+/* the oldest sample a flight may reach back to: held, and after the last closed candidate */
+static uint64_t history_floor(const gs_flight *f)
+{
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    return f->quiet_from > oldest ? f->quiet_from : oldest;
+}
+
 /* Grow the flight backwards in time from the core with the same CUSUM test.
  * Every sample but gross outliers enters the running fit (so a biased early
  * fit corrects itself); the flight's edge is the last sample after which the
@@ -618,8 +635,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     uint64_t alarm = UINT64_MAX;
     uint32_t outl = 0;
     gs_real S = GS_R(0.0);
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
+    uint64_t floor_idx = history_floor(f);
     double t_prev = t_at(f, f->fl_first);
     double t_seed = t_at(f, f->seed_idx);
     uint64_t clean = f->fl_first;
@@ -651,7 +667,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
             alarm = i;
             break;
         }
-        gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        fit_add(f, s);
         gs_fit_solve(&f->fit, r);
         if (S == GS_R(0.0)) clean = i;
     }
@@ -670,8 +686,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
 static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
                             uint64_t *outer, uint64_t *first)
 {
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
+    uint64_t floor_idx = history_floor(f);
     uint64_t head = gs_ring_head(f->ring);
     uint32_t n = 0;
     gs_real z_prev = -INFINITY;
@@ -693,6 +708,26 @@ static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r,
     return n;
 }
 
+/* The boundary time on one side (NaN: unknown) from the flight's edge and the contact
+ * samples past it (those end where contact was detected, alarm: further out the ground
+ * phase is no longer a constant force); *outer = the outermost contact sample. */
+static double boundary_time(const gs_flight *f, const gs_fit_result *r, int side, bool alarm,
+                            uint64_t edge, uint64_t other_edge, bool refine, gs_real pen,
+                            uint64_t *outer)
+{
+    uint64_t first = edge;  /* the first contact sample */
+    *outer = edge;
+    uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
+    if (!refine) return NAN;
+    /* two or more contact samples with a growing deviation: a constant-force model
+     * past the boundary gives a sub-frame time; one: the midpoint is all we know */
+    if (n >= 2)
+        return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
+                               side, edge, *outer, pen, r);
+    if (n == 1) return 0.5 * (t_at(f, first) + t_at(f, edge));
+    return NAN;
+}
+
 /* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
  * not beyond the grown edge? (false when not held) */
 static NOINLINE bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
@@ -704,10 +739,20 @@ static NOINLINE bool inside_edge(const gs_flight *f, uint64_t i, double T, int s
     return past_s(s->t_s, T, side) < 0.0;
 }
 
+/* image up := (ux, uy) normalised; false (unchanged) for a zero or NaN direction */
+static NOINLINE bool set_up(gs_flight *f, gs_real ux, gs_real uy)
+{
+    gs_real nrm = GS_SQRT(ux * ux + uy * uy);
+    if (!(nrm > GS_R(0.0))) return false;
+    f->up_x = ux / nrm;
+    f->up_y = uy / nrm;
+    return true;
+}
+
 /* Restart the seed's level trackers from level u at time t_s (NaN: none) */
 static NOINLINE void restart_levels(gs_flight *f, gs_real u, double t_s)
 {
-    f->blk_min_cur = isfinite(u) ? u : INFINITY;
+    f->blk_min_cur = finite_r(u) ? u : INFINITY;
     f->blk_min_prev = f->blk_min_cur;
     f->blk_t0 = t_s;
     f->peak_u = -INFINITY;
@@ -726,38 +771,23 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
     /* boundary refinement on the up direction of the flight's own acceleration */
     gs_real save_ux = f->up_x, save_uy = f->up_y;
-    if (isfinite(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
+    if (finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
         f->up_x = -r.ax_px_s2 / r.a_px_s2;
         f->up_y = -r.ay_px_s2 / r.a_px_s2;
     }
-    /* the contact samples the boundary model sees end where contact was detected:
-     * further out the ground phase is no longer a constant force */
     uint64_t L = f->fl_first, R = f->fl_last;
-    uint64_t lo = L, hi = R;
-    uint32_t n_left = 0, n_right = 0;
-    uint64_t first_left = L, first_right = R;  /* the first contact sample on each side */
-    if (left_alarm != UINT64_MAX) n_left = contact_run(f, &r, L, -1, &lo, &first_left);
-    if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
-    double T0 = NAN, T1 = NAN;
-    /* a flight longer than the ring holds has lost its edges: no refinement (the ring
-     * holds a contiguous range and lo <= first_left <= L <= R <= first_right <= hi) */
-    if (!held(f, lo) || !held(f, hi))
-        n_left = n_right = 0;
+    /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
+     * holds a contiguous range; the contact samples lie between L and the newest and
+     * are held, so L tells for all of them.) */
+    bool refine = held(f, L);
     gs_real sig = fit_sigma(f, &r);
     gs_real pen = DROP_PENALTY * sig * sig;
-    /* two or more contact samples with a growing deviation: a constant-force model
-     * past the boundary gives a sub-frame time; one: the midpoint is all we know */
-    if (n_left >= 2)
-        T0 = refine_boundary(f, lo, R, -1, L, lo, pen, &r);
-    else if (n_left == 1)
-        T0 = 0.5 * (t_at(f, first_left) + t_at(f, L));
-    if (n_right >= 2)
-        T1 = refine_boundary(f, L, hi, +1, R, hi, pen, &r);
-    else if (n_right == 1)
-        T1 = 0.5 * (t_at(f, first_right) + t_at(f, R));
-    DBG("close: L=%llu R=%llu lo=%llu hi=%llu nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
+    uint64_t lo, hi;  /* the outermost contact samples */
+    double T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
+    double T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
+    DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%.4f T1=%.4f a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
-        n_left, n_right, T0, T1, r.a_px_s2);
+        T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
     uint64_t in_lo = lo, in_hi = hi;
     while (in_lo < in_hi && !inside_edge(f, in_lo, T0, -1, L)) in_lo++;
@@ -793,8 +823,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    if (!finite_d(T0)) T0 = sf->t_s - 0.5 * dt;
-    if (!finite_d(T1)) T1 = sl->t_s + 0.5 * dt;
+    double half_dt = 0.5 * dt;
+    if (!finite_d(T0)) T0 = sf->t_s - half_dt;
+    if (!finite_d(T1)) T1 = sl->t_s + half_dt;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -828,12 +859,12 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         gs_real rise_t = j->t_apex_s - T0;
         j->jump_height_m = GS_R(0.5) * g * rise_t * rise_t;
         j->takeoff_velocity_m_s = g * rise_t;
-        if (isfinite(size)) {
+        if (finite_r(size)) {
             height = size * q;
             j->height_m = height;
             gs_real ra = fr.a_se_px_s2 / fr.a_px_s2;
-            gs_real rs = isfinite(size_se) ? size_se / size : GS_R(0.0);
-            j->height_se_m = height * GS_SQRT((isfinite(ra) ? ra * ra : GS_R(0.0)) + rs * rs);
+            gs_real rs = finite_r(size_se) ? size_se / size : GS_R(0.0);
+            j->height_se_m = height * GS_SQRT((finite_r(ra) ? ra * ra : GS_R(0.0)) + rs * rs);
         }
 
         /* is this a flight at all? (walking bumps, standing, noise) */
@@ -844,7 +875,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
             j->reason = GS_REJ_FEW_SAMPLES;
         else if (max_gap_in > (double)f->cfg->max_gap_s)
             j->reason = GS_REJ_GAP;
-        else if (!isfinite(size))
+        else if (!finite_r(size))
             j->reason = GS_REJ_NO_SIZE;
         else if (fr.rms_px > (gs_real)f->cfg->max_rms_rel * size)
             j->reason = GS_REJ_LARGE_RESIDUAL;
@@ -857,14 +888,14 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
         if (truncated) j->warnings |= GS_WARN_CLIPPED;
-        if (f->n_flights > 0 && isfinite(f->last_g_dir_deg) &&
+        if (f->n_flights > 0 && finite_r(f->last_g_dir_deg) &&
             GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
             j->warnings |= GS_WARN_GRAVITY_TILT;
     }
 
     if (j->accepted) {
         f->last_a_px_s2 = fr.a_px_s2;
-        f->last_g_dir_deg = isfinite(f->last_g_dir_deg)
+        f->last_g_dir_deg = finite_r(f->last_g_dir_deg)
             ? GS_R(0.7) * f->last_g_dir_deg + GS_R(0.3) * fr.g_dir_deg : fr.g_dir_deg;
         /* gravity's direction in the image, from the flights themselves */
         gs_real ux = -fr.ax_px_s2 / fr.a_px_s2, uy = -fr.ay_px_s2 / fr.a_px_s2;
@@ -872,8 +903,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
             ux = GS_R(0.7) * f->up_x + GS_R(0.3) * ux;
             uy = GS_R(0.7) * f->up_y + GS_R(0.3) * uy;
         }
-        gs_real nrm = GS_SQRT(ux * ux + uy * uy);
-        if (nrm > GS_R(0.0)) { f->up_x = ux / nrm; f->up_y = uy / nrm; f->up_from_flight = true; }
+        if (set_up(f, ux, uy)) f->up_from_flight = true;
     }
     f->n_flights++;
     emit(f, &ev);
@@ -917,7 +947,7 @@ static NOINLINE void keep_size(float *ring, uint32_t *n, uint32_t *next, float s
 
 static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed)
 {
-    if (!isfinite(speed)) return;
+    if (!finite_r(speed)) return;
     if (IS_RIGID(f) || !size_ok(s->size_px)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
     if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
@@ -930,13 +960,12 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_t = s->t_s;
     /* body axis -> image up, until flights measure gravity directly */
-    if (!f->up_from_flight && isfinite(s->up_x) && isfinite(s->up_y)) {
+    if (!f->up_from_flight && finite_r(s->up_x) && finite_r(s->up_y)) {
         gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
         gs_real ux = (GS_R(1.0) - kw) * f->up_x + kw * (gs_real)s->up_x;
         gs_real uy = (GS_R(1.0) - kw) * f->up_y + kw * (gs_real)s->up_y;
         if (f->up_n == 0) { ux = s->up_x; uy = s->up_y; }
-        gs_real nrm = GS_SQRT(ux * ux + uy * uy);
-        if (nrm > GS_R(0.0)) { f->up_x = ux / nrm; f->up_y = uy / nrm; }
+        set_up(f, ux, uy);
         f->up_n++;
     }
 }
@@ -993,14 +1022,14 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
     /* size_ref(f, s) again would be sz: nothing between changes what it reads */
     /* sz is positive or NaN (unknown: any finite speed counts) */
-    bool still = isfinite(speed) && !(speed >= STAND_SPEED_REL * sz);
+    bool still = finite_r(speed) && !(speed >= STAND_SPEED_REL * sz);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
         f->noise_init[f->noise_n++] = (float)GS_FABSR(d2);
         if (f->noise_n == NOISE_INIT_N) {
             float tmp[NOISE_INIT_N];
-            for (uint32_t i = 0; i < NOISE_INIT_N; i++) tmp[i] = f->noise_init[i];
+            memcpy(tmp, f->noise_init, sizeof tmp);
             gs_real med = median_f(tmp, NOISE_INIT_N);
             f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = 1.652 s */
             if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
@@ -1028,7 +1057,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     DBG("g t=%.3f um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", tm, um, umin, thr, nz, sz, f->peak_u);
     /* a peak counts once it rose thr above the recent minimum; the drop that
      * confirms it as an apex seeds a flight, however far it has fallen by then */
-    if (!isfinite(f->peak_u)) {
+    if (!finite_r(f->peak_u)) {
         if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; }
         return;
     }
@@ -1103,7 +1132,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
             gs_sample_full p_b;
             const gs_sample_full *p = usable_at(f, j, &p_b);
             if (p && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
-                gs_fit_add(&f->fit, p->t_s, p->x_px, p->y_px, p->w);
+                fit_add(f, p);
         }
         f->fl_last = idx;
         f->pend_ok = 0;
