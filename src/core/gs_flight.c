@@ -374,6 +374,13 @@ static NOINLINE void fit_add(gs_flight *f, const gs_sample_full *s)
     gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
 }
 
+/* the oldest sample a flight may reach back to: held, and after the last closed candidate */
+static NOINLINE uint64_t history_floor(const gs_flight *f)
+{
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    return f->quiet_from > oldest ? f->quiet_from : oldest;
+}
+
 /* Rebuild the running fit robustly from the ring samples [lo, hi]. */
 static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
 {
@@ -406,6 +413,7 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     /* a refit that only fits with a residual far above the noise proves nothing */
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
+    uint64_t stop = side > 0 ? lo : hi;  /* walking inward from the edge */
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
         gs_sample_full s_b;
         gs_real z;
@@ -413,7 +421,8 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
             if (z > VERIFY_Z) return false;
             checked++;
         }
-        if (side > 0) { if (i == lo) break; i--; } else { if (i == hi) break; i++; }
+        if (i == stop) break;
+        i = side > 0 ? i - 1 : i + 1;
     }
     return checked == 2;
 }
@@ -423,14 +432,13 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     double dt = frame_dt(f);
     uint32_t half = (uint32_t)CEIL_D(half_s / dt - 1e-9);
     if (half < 2) half = 2;
-    uint64_t lo = apex >= f->quiet_from + half ? apex - half : f->quiet_from;
+    uint64_t floor_idx = history_floor(f);
+    uint64_t lo = apex > floor_idx + half ? apex - half : floor_idx;
     uint64_t hi = apex + half < newest ? apex + half : newest;
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    if (lo < oldest) lo = oldest;
     /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
         if (count_usable(f, lo, hi) >= 5) break;
-        if (lo > f->quiet_from && lo > oldest) lo--;
+        if (lo > floor_idx) lo--;
         if (hi < newest) hi++;
     }
     if (!refit_range(f, lo, hi)) return false;
@@ -467,7 +475,7 @@ static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
 {
     /* a pivot below this fraction of its diagonal: not positive definite at this precision */
     const gs_real tiny = sizeof(gs_real) < sizeof(double) ? GS_R(1e-6) : GS_R(1e-12);
-    gs_real L[4][4] = {{0}};
+    gs_real L[4][4];  /* each entry is written before it is read */
     for (int i = 0; i < k; i++) {
         for (int j = 0; j <= i; j++) {
             gs_real s = A[i][j];
@@ -492,6 +500,14 @@ static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
         c[i] = s / L[i][i];
     }
     return true;
+}
+
+/* the SSR left after the least-squares solution c of k unknowns: yy - c.b, at least 0 */
+static gs_real ssr_left(gs_real yy, const gs_real c[4], const gs_real b[4], int k)
+{
+    gs_real ssr = yy;
+    for (int m = 0; m < k; m++) ssr -= c[m] * b[m];
+    return ssr > GS_R(0.0) ? ssr : GS_R(0.0);
 }
 
 /* Weighted SSR of u over samples [lo, hi] under parabola + alpha/2 (T - t)^2 for t < T
@@ -530,20 +546,14 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
     gs_real tsr = (gs_real)ts;
     gs_real c3_min = alpha_min_px * tsr * tsr, c3_max = alpha_max_px * tsr * tsr;  /* alpha in tau units */
     bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
-    if (solved && c[3] >= c3_min && c[3] <= c3_max) {
-        gs_real ssr = yy;
-        for (int k = 0; k < 4; k++) ssr -= c[k] * b[k];
-        return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
-    }
+    if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
     /* alpha at a bound: fit the parabola to u - alpha h */
     gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
     gs_real b3[4];
     for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
     gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
     if (!solve_spd(A, b3, 3, c)) return INFINITY;
-    gs_real ssr = yy3;
-    for (int k = 0; k < 3; k++) ssr -= c[k] * b3[k];
-    return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
+    return ssr_left(yy3, c, b3, 3);
 }
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
@@ -617,13 +627,6 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
         if (s && size_ok(s->size_px)) v[n++] = s->size_px;
     }
     return median_se(v, n, se_out);
-}
-
-/* the oldest sample a flight may reach back to: held, and after the last closed candidate */
-static uint64_t history_floor(const gs_flight *f)
-{
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    return f->quiet_from > oldest ? f->quiet_from : oldest;
 }
 
 /* Grow the flight backwards in time from the core with the same CUSUM test.
