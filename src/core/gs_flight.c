@@ -214,6 +214,8 @@ static gs_real med3(gs_real a, gs_real b, gs_real c)
     return a > b ? a : b;
 }
 
+static void restart_levels(gs_flight *f, uint64_t i);
+
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
@@ -233,13 +235,9 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->up_x = GS_R(0.0);
     f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
     f->noise_px = NAN;
-    f->blk_min_cur = INFINITY;
-    f->blk_min_prev = INFINITY;
-    f->blk_t0 = NAN;
-    f->peak_u = -INFINITY;
+    restart_levels(f, UINT64_MAX);  /* no level seen yet */
     f->dt_med_s = NAN;
-    f->stand_last_t = NAN;
-    f->still_since = NAN;
+    gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
     return GS_OK;
@@ -571,8 +569,8 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
     /* search between the outermost contact sample and a little inside the flight */
     double dt = frame_dt(f);
     double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
-    double t_from = t_out, t_to = t_in + (side < 0 ? inside : -inside);
-    if (side > 0) { double tmp = t_from; t_from = t_to; t_to = tmp; }
+    double t_edge = t_in + (side < 0 ? inside : -inside);
+    double t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
     int steps = (int)CEIL_D((t_to - t_from) / dt * BOUNDARY_STEPS);
     if (steps < 1) steps = 1;
     if (steps > 400) steps = 400;
@@ -595,7 +593,7 @@ static gs_real median_se(const float *v, uint32_t n, gs_real *se_out)
 {
     float tmp[MEDIAN_MAX], dev[MEDIAN_MAX];
     if (n > MEDIAN_MAX) n = MEDIAN_MAX;
-    for (uint32_t i = 0; i < n; i++) tmp[i] = v[i];
+    memcpy(tmp, v, n * sizeof tmp[0]);
     gs_real med = median_f(tmp, n);
     if (n >= 2) {
         for (uint32_t i = 0; i < n; i++) dev[i] = (float)GS_FABSR((gs_real)tmp[i] - med);
@@ -733,13 +731,23 @@ static double boundary_time(const gs_flight *f, const gs_fit_result *r, int side
 
 /* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
  * not beyond the grown edge? (false when not held) */
-static NOINLINE bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
+static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
 {
     gs_sample_full s_b;
     const gs_sample_full *s = at(f, i, &s_b);
     if (!s) return false;
     if (!finite_d(T)) return side < 0 ? i >= edge : i <= edge;
     return past_s(s->t_s, T, side) < 0.0;
+}
+
+/* The flight's outermost sample on one side: from `from` step toward `to` (inward)
+ * until a sample is inside the flight (inside_edge) or `to` is reached. */
+static NOINLINE uint64_t trim_edge(const gs_flight *f, uint64_t from, uint64_t to, double T, int side,
+                                   uint64_t edge)
+{
+    uint64_t i = from;
+    while (i != to && !inside_edge(f, i, T, side, edge)) i = side < 0 ? i + 1 : i - 1;
+    return i;
 }
 
 /* image up := (ux, uy) normalised; false (unchanged) for a zero or NaN direction */
@@ -752,12 +760,15 @@ static NOINLINE bool set_up(gs_flight *f, gs_real ux, gs_real uy)
     return true;
 }
 
-/* Restart the seed's level trackers from level u at time t_s (NaN: none) */
-static NOINLINE void restart_levels(gs_flight *f, gs_real u, double t_s)
+/* Restart the seed's level trackers from ring sample i (from nothing when not held) */
+static NOINLINE void restart_levels(gs_flight *f, uint64_t i)
 {
+    gs_sample_full s_b;
+    const gs_sample_full *s = at(f, i, &s_b);
+    gs_real u = s ? u_of(f, s) : NAN;
     f->blk_min_cur = finite_r(u) ? u : INFINITY;
     f->blk_min_prev = f->blk_min_cur;
-    f->blk_t0 = t_s;
+    f->blk_t0 = s ? s->t_s : NAN;
     f->peak_u = -INFINITY;
     f->n_hist = 0;
 }
@@ -792,9 +803,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
-    uint64_t in_lo = lo, in_hi = hi;
-    while (in_lo < in_hi && !inside_edge(f, in_lo, T0, -1, L)) in_lo++;
-    while (in_hi > in_lo && !inside_edge(f, in_hi, T1, +1, R)) in_hi--;
+    uint64_t in_lo = trim_edge(f, lo, hi, T0, -1, L);
+    uint64_t in_hi = trim_edge(f, hi, in_lo, T1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
 
@@ -916,12 +926,7 @@ done:
      * see the contact samples that follow it */
     f->quiet_from = newest;
     if (land_idx != UINT64_MAX && land_idx < newest) f->quiet_from = land_idx;
-    {
-        /* next seeds start after the landing: restart the level trackers */
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, newest, &s_b);
-        restart_levels(f, s ? u_of(f, s) : NAN, s ? s->t_s : NAN);
-    }
+    restart_levels(f, newest);  /* next seeds start after the landing */
 }
 
 /* ---- the per-sample state machine ------------------------------------------ */
@@ -1166,7 +1171,7 @@ void gs_flight_update(gs_flight *f)
                 if (f->state == GS_FS_AIRBORNE) {
                     close_candidate(f, f->last_idx, UINT64_MAX, true);
                 }
-                restart_levels(f, NAN, NAN);
+                restart_levels(f, UINT64_MAX);  /* never held: from nothing */
                 set_state(f, GS_FS_GROUND, s->t_s);
             }
         }
