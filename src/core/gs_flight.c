@@ -379,15 +379,15 @@ static NOINLINE uint64_t history_floor(const gs_flight *f)
     return f->quiet_from > oldest ? f->quiet_from : oldest;
 }
 
-/* Rebuild the running fit robustly from the ring samples [lo, hi]. */
-static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
+/* Rebuild the running fit robustly from the ring samples [lo, hi]; *r: its solution
+ * when true (scratch otherwise). */
+static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r)
 {
     double t_lo = t_at(f, lo), t_hi = t_at(f, hi);
     if (!finite_d(t_lo) || !finite_d(t_hi) || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
-    gs_fit_result r;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, &r) != GS_OK)
+    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, r) != GS_OK)
         return false;
     double tspan = t_hi - t_lo;
     gs_fit_init(&f->fit, 0.5 * (t_lo + t_hi), tspan > 0.0 ? tspan : frame_dt(f));
@@ -396,8 +396,7 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
         const gs_sample_full *s = usable_at(f, i, &s_b);
         if (s && gs_fit_kept(f->keep, (uint32_t)(i - lo))) fit_add(f, s);
     }
-    gs_fit_result chk;
-    return gs_fit_solve(&f->fit, &chk) == GS_OK;
+    return gs_fit_solve(&f->fit, r) == GS_OK;
 }
 
 /* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
@@ -405,9 +404,8 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
  * false alarm (true contact deviates by far more than a refit can absorb). */
 static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge, int side)
 {
-    if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
-    if (gs_fit_solve(&f->fit, &r) != GS_OK) return false;
+    if (!refit_range(f, lo, hi, &r)) return false;
     /* a refit that only fits with a residual far above the noise proves nothing */
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
@@ -439,11 +437,11 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
         if (lo > floor_idx) lo--;
         if (hi < newest) hi++;
     }
-    if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
+    if (!refit_range(f, lo, hi, &r)) return false;
     uint32_t n_usable = count_usable(f, lo, hi);
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
-    bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
+    bool enough = r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
         DBG("seed at %llu (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", (unsigned long long)apex, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
         return false;
@@ -674,7 +672,8 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     }
     if (clean != f->fl_first || alarm != UINT64_MAX) {
         f->fl_first = clean;
-        if (refit_range(f, f->fl_first, f->fl_last)) gs_fit_solve(&f->fit, r);
+        gs_fit_result rr;  /* r changes only when the refit succeeds */
+        if (refit_range(f, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, r);
     }
     return alarm;
 }
@@ -1090,7 +1089,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_full *s)
 {
     /* the running fit may hold samples past the edge: rebuild it over the flight */
-    refit_range(f, f->fl_first, f->fl_last);
+    gs_fit_result r;
+    refit_range(f, f->fl_first, f->fl_last, &r);
     close_candidate(f, idx, alarm, false);
     set_state(f, GS_FS_GROUND, s->t_s);
 }
