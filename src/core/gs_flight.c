@@ -40,13 +40,12 @@
 /* small helpers called from several places: one copy is smaller than inlining it everywhere */
 #define NOINLINE __attribute__((noinline))
 
-/* ceil(x) of a double: libm's where gs_real is double, else the same value without
- * libm (only of finite |x| < 2^62: frame counts) */
-#define CEIL_D(x) (GS_REAL_IS_FLOAT ? ceil_d(x) : ceil(x))
-static NOINLINE double ceil_d(double x)
+/* ceil(x) as an integer, without libm, for frame counts (finite |x| < 2^62; they are
+ * far below). One 64-bit conversion for all of them (the ring links it anyway). */
+static NOINLINE int64_t ceil_count(double x)
 {
-    double t = (double)(long long)x;  /* toward zero, exact */
-    return t < x ? t + 1.0 : t;
+    int64_t t = (int64_t)x;  /* toward zero, exact */
+    return (double)t < x ? t + 1 : t;
 }
 
 /* tuning: thresholds in units of the noise or of the object's size */
@@ -426,7 +425,7 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
 static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double half_s)
 {
     double dt = frame_dt(f);
-    uint32_t half = (uint32_t)CEIL_D(half_s / dt - 1e-9);
+    uint32_t half = (uint32_t)ceil_count(half_s / dt - 1e-9);
     if (half < 2) half = 2;
     uint64_t floor_idx = history_floor(f);
     uint64_t lo = apex > floor_idx + half ? apex - half : floor_idx;
@@ -569,9 +568,8 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
     double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
     double t_edge = t_in + (side < 0 ? inside : -inside);
     double t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
-    int steps = (int)CEIL_D((t_to - t_from) / dt * BOUNDARY_STEPS);
-    if (steps < 1) steps = 1;
-    if (steps > 400) steps = 400;
+    int64_t n_steps = ceil_count((t_to - t_from) / dt * BOUNDARY_STEPS);
+    int steps = n_steps < 1 ? 1 : n_steps > 400 ? 400 : (int)n_steps;
     gs_real best = INFINITY;
     double best_T = NAN;
     for (int k = 0; k <= steps; k++) {
@@ -935,7 +933,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 /* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
 static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u)
 {
-    uint64_t k = (uint64_t)CEIL_D(0.1 / frame_dt(f));
+    uint64_t k = (uint64_t)ceil_count(0.1 / frame_dt(f));
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
