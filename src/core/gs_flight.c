@@ -78,7 +78,6 @@ static NOINLINE int64_t ceil_count(double x)
 /* isfinite of a gs_real (or float) value, in one place */
 static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
 
-/* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 /* isfinite of a double by its exponent bits: the same answer without soft-float compares */
 static bool finite_d(double x)
 {
@@ -87,6 +86,7 @@ static bool finite_d(double x)
     return ((uint32_t)(b >> 52) & 0x7ffu) != 0x7ffu;
 }
 
+/* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
 {
     return gs_ring_get(f->ring, i, buf) ? buf : NULL;
