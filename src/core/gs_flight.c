@@ -975,11 +975,17 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     }
 }
 
+/* the newest standing size (stand_n > 0) */
+static float last_stand_size(const gs_flight *f)
+{
+    return f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
+}
+
 double gs_flight_stand_at(const gs_flight *f, double t_s)
 {
     /* the ring gives times back to the microsecond: same frame within half a millisecond */
     if (!f || f->stand_n == 0 || !(fabs(f->stand_last_t - t_s) < 5e-4)) return NAN;
-    return (gs_real)f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
+    return (gs_real)last_stand_size(f);
 }
 
 void gs_flight_forget_body(gs_flight *f)
@@ -995,8 +1001,7 @@ void gs_flight_forget_body(gs_flight *f)
 static gs_real size_ref(const gs_flight *f, const gs_sample_full *s)
 {
     if (!IS_RIGID(f) && f->stand_n > 0) { /* a rigid object has no standing sizes */
-        uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
-        return f->stand_size[i];
+        return last_stand_size(f);
     }
     return size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
 }
