@@ -37,13 +37,15 @@
 #define DBG(...) ((void)0)
 #endif
 
-/* ceil(x) of a double: libm's where gs_real is double, else the same value without
- * libm (only of finite |x| < 2^62: frame counts) */
-#define CEIL_D(x) (GS_REAL_IS_FLOAT ? ceil_d(x) : ceil(x))
-static double ceil_d(double x)
+/* small helpers called from several places: one copy is smaller than inlining it everywhere */
+#define NOINLINE __attribute__((noinline))
+
+/* ceil(x) as an integer, without libm, for frame counts (finite |x| < 2^62; they are
+ * far below). One 64-bit conversion for all of them (the ring links it anyway). */
+static NOINLINE int64_t ceil_count(double x)
 {
-    double t = (double)(long long)x;  /* toward zero, exact */
-    return t < x ? t + 1.0 : t;
+    int64_t t = (int64_t)x;  /* toward zero, exact */
+    return (double)t < x ? t + 1 : t;
 }
 
 /* tuning: thresholds in units of the noise or of the object's size */
@@ -73,6 +75,17 @@ static double ceil_d(double x)
 #define STAND_SETTLE_S   0.2          /* still this long before a frame counts as standing */
 #define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
+/* isfinite of a gs_real (or float) value, in one place */
+static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
+
+/* isfinite of a double by its exponent bits: the same answer without soft-float compares */
+static bool finite_d(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return ((uint32_t)(b >> 52) & 0x7ffu) != 0x7ffu;
+}
+
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
 {
@@ -90,18 +103,45 @@ static double t_at(const gs_flight *f, uint64_t i)
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && isfinite(s->x_px) && isfinite(s->y_px) && isfinite(s->t_s);
+    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px) && finite_d(s->t_s);
 }
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
 
-static bool usable_at(const gs_flight *f, uint64_t i)
+/* t1 - t0 longer than a configured span (false when either time is NaN) */
+static NOINLINE bool span_over(double t1, double t0, float span_s)
 {
-    gs_sample_full b;
-    return usable(at(f, i, &b));
+    return t1 - t0 > (double)span_s;
 }
 
-static gs_real u_of(const gs_flight *f, const gs_sample_full *s)
+/* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side.
+ * The sign of a double difference is exact, so comparing it with 0 is comparing t with T. */
+static NOINLINE double past_s(double t, double T, int side)
+{
+    double d = t - T;
+    return side < 0 ? -d : d;
+}
+
+/* Ring sample i unpacked into *buf when held and usable, else NULL. */
+static const gs_sample_full *usable_at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
+{
+    const gs_sample_full *s = at(f, i, buf);
+    return usable(s) ? s : NULL;
+}
+
+/* usable samples among [lo, hi] */
+static NOINLINE uint32_t count_usable(const gs_flight *f, uint64_t lo, uint64_t hi)
+{
+    uint32_t n = 0;
+    gs_sample_full b;
+    for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i, &b) ? 1u : 0u;
+    return n;
+}
+
+/* a measured size: positive and finite */
+static NOINLINE bool size_ok(float size_px) { return size_px > 0.0f && size_px < INFINITY; }
+
+static NOINLINE gs_real u_of(const gs_flight *f, const gs_sample_full *s)
 {
     return (gs_real)s->x_px * f->up_x + (gs_real)s->y_px * f->up_y;
 }
@@ -121,7 +161,7 @@ const char *gs_flight_state_name(gs_flight_state s)
     return "?";
 }
 
-static void set_state(gs_flight *f, gs_flight_state to, double t_s)
+static NOINLINE void set_state(gs_flight *f, gs_flight_state to, double t_s)
 {
     if (f->state == to) return;
     if (GS_WITH_TRACE && f->trace) {
@@ -173,6 +213,8 @@ static gs_real med3(gs_real a, gs_real b, gs_real c)
     return a > b ? a : b;
 }
 
+static void restart_levels(gs_flight *f, uint64_t i);
+
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
@@ -192,13 +234,9 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->up_x = GS_R(0.0);
     f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
     f->noise_px = NAN;
-    f->blk_min_cur = INFINITY;
-    f->blk_min_prev = INFINITY;
-    f->blk_t0 = NAN;
-    f->peak_u = -INFINITY;
+    restart_levels(f, UINT64_MAX);  /* no level seen yet */
     f->dt_med_s = NAN;
-    f->stand_last_t = NAN;
-    f->still_since = NAN;
+    gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
     return GS_OK;
@@ -208,7 +246,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
 
 static gs_real noise_floor(const gs_flight *f)
 {
-    gs_real n = isfinite(f->noise_px) ? f->noise_px : GS_R(1.0);
+    gs_real n = finite_r(f->noise_px) ? f->noise_px : GS_R(1.0);
     return n > GS_R(0.05) ? n : GS_R(0.05);
 }
 
@@ -216,7 +254,7 @@ static gs_real noise_floor(const gs_flight *f)
 static gs_real fit_sigma(const gs_flight *f, const gs_fit_result *r)
 {
     gs_real s = noise_floor(f);
-    if (r->n >= 8 && isfinite(r->rms_px)) {
+    if (r->n >= 8 && finite_r(r->rms_px)) {
         gs_real sf = r->rms_px / GS_SQRT(GS_R(2.0)) * GS_SQRT((gs_real)r->n / (gs_real)(r->n - 3));
         if (sf > s) s = sf;
     }
@@ -240,9 +278,9 @@ static gs_real pred_var_factor(const gs_fit *fit, double t_s)
  * outlier (bad keypoints: far off sideways or below the parabola); else *z is
  * the deviation against gravity in units of its standard deviation (contact
  * pushes the body above the parabola, so z grows quadratically after it). */
-static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_result *r,
-                        const gs_sample_full *s, gs_real *z)
+static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sample_full *s, gs_real *z)
 {
+    const gs_fit *fit = &f->fit;
     /* per sample and per boundary candidate: gs_real; only the time difference is double */
     gs_real dt = (gs_real)(s->t_s - r->t0_s);
     gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
@@ -250,18 +288,26 @@ static bool test_sample(const gs_flight *f, const gs_fit *fit, const gs_fit_resu
     gs_real py = (gs_real)r->y0_px + (gs_real)r->vy_px_s * dt + GS_R(0.5) * ay * dt * dt;
     gs_real ex = (gs_real)s->x_px - px, ey = (gs_real)s->y_px - py;
     gs_real gx = ax / a, gy = ay / a;
-    if (!isfinite(gx) || !isfinite(gy)) { gx = (gs_real)-f->up_x; gy = (gs_real)-f->up_y; }
+    if (!finite_r(gx) || !finite_r(gy)) { gx = (gs_real)-f->up_x; gy = (gs_real)-f->up_y; }
     gs_real up = -(ex * gx + ey * gy);
     gs_real perp = ex * (-gy) + ey * gx;
     gs_real sig = (gs_real)fit_sigma(f, r);
     gs_real vf = pred_var_factor(fit, s->t_s);
-    gs_real tot = sig * GS_SQRT(GS_R(1.0) + (isfinite(vf) ? vf : GS_R(1e6)));
+    gs_real tot = sig * GS_SQRT(GS_R(1.0) + (finite_r(vf) ? vf : GS_R(1e6)));
     *z = (gs_real)(up / tot);
     return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
 }
 
+/* Ring sample i when usable and no gross outlier against the fit r (its z in *z), else NULL. */
+static const gs_sample_full *tested_at(const gs_flight *f, const gs_fit_result *r, uint64_t i,
+                                       gs_sample_full *buf, gs_real *z)
+{
+    const gs_sample_full *s = usable_at(f, i, buf);
+    return s && test_sample(f, r, s, z) ? s : NULL;
+}
+
 /* one-sided CUSUM of z: contact raises it, noise drains it */
-static gs_real cusum_step(gs_real S, gs_real z)
+static NOINLINE gs_real cusum_step(gs_real S, gs_real z)
 {
     if (z > CUSUM_ZMAX) z = CUSUM_ZMAX;
     S += z - CUSUM_K;
@@ -269,9 +315,9 @@ static gs_real cusum_step(gs_real S, gs_real z)
 }
 
 /* typical frame interval from the history (for time-based spans) */
-static double frame_dt(const gs_flight *f)
+static NOINLINE double frame_dt(const gs_flight *f)
 {
-    return (isfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
+    return (finite_d(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
@@ -286,7 +332,7 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
 {
     if (!(r->a_px_s2 > GS_R(0.0))) return false;
     /* a fit of few noisy samples gets the benefit of two standard errors */
-    gs_real rel_se = (isfinite(r->a_se_px_s2) && r->a_se_px_s2 > GS_R(0.0)) ? r->a_se_px_s2 / r->a_px_s2 : GS_R(0.0);
+    gs_real rel_se = (finite_r(r->a_se_px_s2) && r->a_se_px_s2 > GS_R(0.0)) ? r->a_se_px_s2 / r->a_px_s2 : GS_R(0.0);
     gs_real cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
     gs_real max_ang = f->up_from_flight ? GS_R(25.0) : (f->up_n > 0 ? GS_R(40.0) : GS_R(60.0));
     max_ang += GS_R(2.0) * rel_se * GS_R(180.0) / GS_PI;
@@ -294,15 +340,16 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
     /* a threshold: single precision is plenty where double is emulated */
     if (!(cosang > (gs_real)GS_COS(max_ang * GS_PI / GS_R(180.0)))) return false;
     gs_real a_hi = r->a_px_s2 + GS_R(2.0) * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - GS_R(2.0) * rel_se * r->a_px_s2;
-    if (isfinite(size_px) && size_px > GS_R(0.0)) {
+    gs_real a_min = -(gs_real)INFINITY, a_max = (gs_real)INFINITY;  /* no size, no flight yet: any */
+    if (finite_r(size_px) && size_px > GS_R(0.0)) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
-        gs_real a_min = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_max_m * EMIT_FACTOR);
-        gs_real a_max = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_min_m / EMIT_FACTOR);
-        if (a_hi < a_min || a_lo > a_max) return false;
-    } else if (isfinite(f->last_a_px_s2)) {
-        if (a_hi < f->last_a_px_s2 / EMIT_FACTOR || a_lo > f->last_a_px_s2 * EMIT_FACTOR) return false;
+        a_min = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_max_m * EMIT_FACTOR);
+        a_max = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_min_m / EMIT_FACTOR);
+    } else if (finite_r(f->last_a_px_s2)) {
+        a_min = f->last_a_px_s2 / EMIT_FACTOR;
+        a_max = f->last_a_px_s2 * EMIT_FACTOR;
     }
-    return true;
+    return !(a_hi < a_min || a_lo > a_max);
 }
 
 /* the object's size in px for gating: standing stature, or the rigid object's latest size */
@@ -311,32 +358,44 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
     if (IS_RIGID(f)) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
-        return s && isfinite(s->size_px) ? (gs_real)s->size_px : NAN;
+        /* (a size of 0 gates as an unknown one: plausible_fall needs it positive) */
+        return s && size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
     }
     gs_real se;
     return stand_size(f, &se);
 }
 
-/* Rebuild the running fit robustly from the ring samples [lo, hi]. */
-static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
+/* sample s into the running fit */
+static NOINLINE void fit_add(gs_flight *f, const gs_sample_full *s)
 {
-    gs_sample_full a_b, b_b;
-    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
-    if (!a || !b || hi <= lo) return false;
+    gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+}
+
+/* the oldest sample a flight may reach back to: held, and after the last closed candidate */
+static NOINLINE uint64_t history_floor(const gs_flight *f)
+{
+    uint64_t oldest = gs_ring_oldest(f->ring);
+    return f->quiet_from > oldest ? f->quiet_from : oldest;
+}
+
+/* Rebuild the running fit robustly from the ring samples [lo, hi]; *r: its solution
+ * when true (scratch otherwise). */
+static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r)
+{
+    double t_lo = t_at(f, lo), t_hi = t_at(f, hi);
+    if (!finite_d(t_lo) || !finite_d(t_hi) || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
-    gs_fit_result r;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, &r) != GS_OK)
+    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, r) != GS_OK)
         return false;
-    double tspan = b->t_s - a->t_s;
-    gs_fit_init(&f->fit, 0.5 * (a->t_s + b->t_s), tspan > 0.0 ? tspan : frame_dt(f));
+    double tspan = t_hi - t_lo;
+    gs_fit_init(&f->fit, 0.5 * (t_lo + t_hi), tspan > 0.0 ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
-        if (usable(s) && gs_fit_kept(f->keep, (uint32_t)(i - lo))) gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        const gs_sample_full *s = usable_at(f, i, &s_b);
+        if (s && gs_fit_kept(f->keep, (uint32_t)(i - lo))) fit_add(f, s);
     }
-    gs_fit_result chk;
-    return gs_fit_solve(&f->fit, &chk) == GS_OK;
+    return gs_fit_solve(&f->fit, r) == GS_OK;
 }
 
 /* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
@@ -344,23 +403,21 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi)
  * false alarm (true contact deviates by far more than a refit can absorb). */
 static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge, int side)
 {
-    if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
-    if (gs_fit_solve(&f->fit, &r) != GS_OK) return false;
+    if (!refit_range(f, lo, hi, &r)) return false;
     /* a refit that only fits with a residual far above the noise proves nothing */
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
+    uint64_t stop = side > 0 ? lo : hi;  /* walking inward from the edge */
     for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
         gs_real z;
-        if (usable(s)) {
-            if (test_sample(f, &f->fit, &r, s, &z)) {
-                if (z > VERIFY_Z) return false;
-                checked++;
-            }
+        if (tested_at(f, &r, i, &s_b, &z)) {
+            if (z > VERIFY_Z) return false;
+            checked++;
         }
-        if (side > 0) { if (i == lo) break; i--; } else { if (i == hi) break; i++; }
+        if (i == stop) break;
+        i = side > 0 ? i - 1 : i + 1;
     }
     return checked == 2;
 }
@@ -368,26 +425,22 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
 static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double half_s)
 {
     double dt = frame_dt(f);
-    uint32_t half = (uint32_t)CEIL_D(half_s / dt - 1e-9);
+    uint32_t half = (uint32_t)ceil_count(half_s / dt - 1e-9);
     if (half < 2) half = 2;
-    uint64_t lo = apex >= f->quiet_from + half ? apex - half : f->quiet_from;
+    uint64_t floor_idx = history_floor(f);
+    uint64_t lo = apex > floor_idx + half ? apex - half : floor_idx;
     uint64_t hi = apex + half < newest ? apex + half : newest;
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    if (lo < oldest) lo = oldest;
     /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
-        uint32_t n = 0;
-        for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i) ? 1u : 0u;
-        if (n >= 5) break;
-        if (lo > f->quiet_from && lo > oldest) lo--;
+        if (count_usable(f, lo, hi) >= 5) break;
+        if (lo > floor_idx) lo--;
         if (hi < newest) hi++;
     }
-    if (!refit_range(f, lo, hi)) return false;
     gs_fit_result r;
-    uint32_t n_usable = 0;
-    for (uint64_t i = lo; i <= hi; i++) n_usable += usable_at(f, i) ? 1u : 0u;
+    if (!refit_range(f, lo, hi, &r)) return false;
+    uint32_t n_usable = count_usable(f, lo, hi);
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
-    bool enough = gs_fit_solve(&f->fit, &r) == GS_OK && r.n >= 5 && 4u * r.n >= 3u * n_usable;
+    bool enough = r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
         DBG("seed at %llu (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", (unsigned long long)apex, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
         return false;
@@ -417,7 +470,7 @@ static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
 {
     /* a pivot below this fraction of its diagonal: not positive definite at this precision */
     const gs_real tiny = sizeof(gs_real) < sizeof(double) ? GS_R(1e-6) : GS_R(1e-12);
-    gs_real L[4][4] = {{0}};
+    gs_real L[4][4];  /* each entry is written before it is read */
     for (int i = 0; i < k; i++) {
         for (int j = 0; j <= i; j++) {
             gs_real s = A[i][j];
@@ -444,6 +497,14 @@ static bool solve_spd(gs_real A[4][4], gs_real b[4], int k, gs_real c[4])
     return true;
 }
 
+/* the SSR left after the least-squares solution c of k unknowns: yy - c.b, at least 0 */
+static gs_real ssr_left(gs_real yy, const gs_real c[4], const gs_real b[4], int k)
+{
+    gs_real ssr = yy;
+    for (int m = 0; m < k; m++) ssr -= c[m] * b[m];
+    return ssr > GS_R(0.0) ? ssr : GS_R(0.0);
+}
+
 /* Weighted SSR of u over samples [lo, hi] under parabola + alpha/2 (T - t)^2 for t < T
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
@@ -460,12 +521,12 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
     gs_real ts2 = (gs_real)(ts * ts);
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
         gs_real z;
-        if (!usable(s) || !test_sample(f, &f->fit, r, s, &z)) continue;  /* gross outliers out */
+        const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
+        if (!s) continue;  /* gross outliers out */
         gs_real w = (gs_real)s->w;
         gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
-        gs_real d = (gs_real)(side < 0 ? (T - s->t_s) : (s->t_s - T));
+        gs_real d = (gs_real)past_s(s->t_s, T, side);
         gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
         gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
@@ -480,50 +541,42 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
     gs_real tsr = (gs_real)ts;
     gs_real c3_min = alpha_min_px * tsr * tsr, c3_max = alpha_max_px * tsr * tsr;  /* alpha in tau units */
     bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
-    if (solved && c[3] >= c3_min && c[3] <= c3_max) {
-        gs_real ssr = yy;
-        for (int k = 0; k < 4; k++) ssr -= c[k] * b[k];
-        return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
-    }
+    if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
     /* alpha at a bound: fit the parabola to u - alpha h */
     gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
     gs_real b3[4];
     for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
     gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
     if (!solve_spd(A, b3, 3, c)) return INFINITY;
-    gs_real ssr = yy3;
-    for (int k = 0; k < 3; k++) ssr -= c[k] * b3[k];
-    return ssr > GS_R(0.0) ? (gs_real)ssr : GS_R(0.0);
+    return ssr_left(yy3, c, b3, 3);
 }
 
-/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples. */
+/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
+ * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
 static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
-                              uint64_t edge_in, uint64_t edge_out, gs_real alpha_min_px,
-                              gs_real alpha_max_px, double t_grown, gs_real penalty,
+                              uint64_t edge_in, uint64_t edge_out, gs_real penalty,
                               const gs_fit_result *r)
 {
-    gs_sample_full a_b, b_b;
-    const gs_sample_full *a = at(f, lo, &a_b), *b = at(f, hi, &b_b);
-    gs_sample_full ei_b, eo_b;
-    const gs_sample_full *ei = at(f, edge_in, &ei_b), *eo = at(f, edge_out, &eo_b);
-    if (!a || !b || !ei || !eo) return NAN;
-    double tc = 0.5 * (a->t_s + b->t_s), ts = 0.5 * (b->t_s - a->t_s);
+    gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
+    gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
+    double t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
+    if (!finite_d(t_lo) || !finite_d(t_hi) || !finite_d(t_in) || !finite_d(t_out)) return NAN;
+    double tc = 0.5 * (t_lo + t_hi), ts = 0.5 * (t_hi - t_lo);
     if (!(ts > 0.0)) return NAN;
     /* search between the outermost contact sample and a little inside the flight */
     double dt = frame_dt(f);
     double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
-    double t_from = eo->t_s, t_to = ei->t_s + (side < 0 ? inside : -inside);
-    if (side > 0) { double tmp = t_from; t_from = t_to; t_to = tmp; }
-    int steps = (int)CEIL_D((t_to - t_from) / dt * BOUNDARY_STEPS);
-    if (steps < 1) steps = 1;
-    if (steps > 400) steps = 400;
+    double t_edge = t_in + (side < 0 ? inside : -inside);
+    double t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
+    int64_t n_steps = ceil_count((t_to - t_from) / dt * BOUNDARY_STEPS);
+    int steps = n_steps < 1 ? 1 : n_steps > 400 ? 400 : (int)n_steps;
     gs_real best = INFINITY;
     double best_T = NAN;
     for (int k = 0; k <= steps; k++) {
         double T = t_from + (t_to - t_from) * (double)k / (double)steps;
         gs_real ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
         /* dropping samples the online test took as flight must pay for itself */
-        if ((side < 0 && T > t_grown) || (side > 0 && T < t_grown)) ssr += penalty;
+        if (past_s(T, t_in, side) < 0.0) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
@@ -536,7 +589,7 @@ static gs_real median_se(const float *v, uint32_t n, gs_real *se_out)
 {
     float tmp[MEDIAN_MAX], dev[MEDIAN_MAX];
     if (n > MEDIAN_MAX) n = MEDIAN_MAX;
-    for (uint32_t i = 0; i < n; i++) tmp[i] = v[i];
+    memcpy(tmp, v, n * sizeof tmp[0]);
     gs_real med = median_f(tmp, n);
     if (n >= 2) {
         for (uint32_t i = 0; i < n; i++) dev[i] = (float)GS_FABSR((gs_real)tmp[i] - med);
@@ -565,7 +618,7 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
     for (uint64_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        if (s && isfinite(s->size_px) && s->size_px > 0.0f) v[n++] = s->size_px;
+        if (s && size_ok(s->size_px)) v[n++] = s->size_px;
     }
     return median_se(v, n, se_out);
 }
@@ -577,16 +630,11 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
 static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
 {
     uint64_t alarm = UINT64_MAX;
-    double max_gap = (double)f->cfg->max_gap_s;
     uint32_t outl = 0;
     gs_real S = GS_R(0.0);
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
-    gs_sample_full first_b;
-    const gs_sample_full *first = at(f, f->fl_first, &first_b);
-    double t_prev = first ? first->t_s : NAN;
-    gs_sample_full sd_b;
-    const gs_sample_full *sd = at(f, f->seed_idx, &sd_b);
+    uint64_t floor_idx = history_floor(f);
+    double t_prev = t_at(f, f->fl_first);
+    double t_seed = t_at(f, f->seed_idx);
     uint64_t clean = f->fl_first;
     uint64_t i = f->fl_first;
     while (i > floor_idx) {
@@ -595,11 +643,11 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s) break;
         if (!usable(s)) continue;
-        if (t_prev - s->t_s > max_gap) break;
-        if (sd && sd->t_s - s->t_s > (double)f->cfg->max_flight_s) break;
+        if (span_over(t_prev, s->t_s, f->cfg->max_gap_s)) break;
+        if (span_over(t_seed, s->t_s, f->cfg->max_flight_s)) break;
         t_prev = s->t_s;
         gs_real z;
-        if (!test_sample(f, &f->fit, r, s, &z)) {
+        if (!test_sample(f, r, s, &z)) {
             if (++outl > 2) break;
             continue;
         }
@@ -616,13 +664,14 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
             alarm = i;
             break;
         }
-        gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+        fit_add(f, s);
         gs_fit_solve(&f->fit, r);
         if (S == GS_R(0.0)) clean = i;
     }
     if (clean != f->fl_first || alarm != UINT64_MAX) {
         f->fl_first = clean;
-        if (refit_range(f, f->fl_first, f->fl_last)) gs_fit_solve(&f->fit, r);
+        gs_fit_result rr;  /* r changes only when the refit succeeds */
+        if (refit_range(f, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, r);
     }
     return alarm;
 }
@@ -632,11 +681,10 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
  * deviation against gravity keeps growing, as under a constant contact force
  * (after an impact the body soon stops following it). Returns how many;
  * *outer = the outermost, *first = the nearest. */
-static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
+static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
                             uint64_t *outer, uint64_t *first)
 {
-    uint64_t oldest = gs_ring_oldest(f->ring);
-    uint64_t floor_idx = f->quiet_from > oldest ? f->quiet_from : oldest;
+    uint64_t floor_idx = history_floor(f);
     uint64_t head = gs_ring_head(f->ring);
     uint32_t n = 0;
     gs_real z_prev = -INFINITY;
@@ -647,10 +695,8 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
         if (side < 0) { if (i <= floor_idx) break; i--; }
         else { if (i + 1 >= head) break; i++; }
         gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
-        if (!usable(s)) continue;
         gs_real z;
-        if (!test_sample(f, &f->fit, r, s, &z)) continue;  /* a glitch: look past it */
+        if (!tested_at(f, r, i, &s_b, &z)) continue;  /* a glitch: look past it */
         if (n > 0 && !(z > z_prev)) break;
         if (n == 0) *first = i;
         *outer = i;
@@ -658,6 +704,70 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t
         n++;
     }
     return n;
+}
+
+/* The boundary time on one side (NaN: unknown) from the flight's edge and the contact
+ * samples past it (those end where contact was detected, alarm: further out the ground
+ * phase is no longer a constant force); *outer = the outermost contact sample. */
+static double boundary_time(const gs_flight *f, const gs_fit_result *r, int side, bool alarm,
+                            uint64_t edge, uint64_t other_edge, bool refine, gs_real pen,
+                            uint64_t *outer)
+{
+    uint64_t first = edge;  /* the first contact sample */
+    *outer = edge;
+    uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
+    if (!refine) return NAN;
+    /* two or more contact samples with a growing deviation: a constant-force model
+     * past the boundary gives a sub-frame time; one: the midpoint is all we know */
+    if (n >= 2)
+        return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
+                               side, edge, *outer, pen, r);
+    if (n == 1) return 0.5 * (t_at(f, first) + t_at(f, edge));
+    return NAN;
+}
+
+/* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
+ * not beyond the grown edge? (false when not held) */
+static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
+{
+    gs_sample_full s_b;
+    const gs_sample_full *s = at(f, i, &s_b);
+    if (!s) return false;
+    if (!finite_d(T)) return side < 0 ? i >= edge : i <= edge;
+    return past_s(s->t_s, T, side) < 0.0;
+}
+
+/* The flight's outermost sample on one side: from `from` step toward `to` (inward)
+ * until a sample is inside the flight (inside_edge) or `to` is reached. */
+static NOINLINE uint64_t trim_edge(const gs_flight *f, uint64_t from, uint64_t to, double T, int side,
+                                   uint64_t edge)
+{
+    uint64_t i = from;
+    while (i != to && !inside_edge(f, i, T, side, edge)) i = side < 0 ? i + 1 : i - 1;
+    return i;
+}
+
+/* image up := (ux, uy) normalised; false (unchanged) for a zero or NaN direction */
+static NOINLINE bool set_up(gs_flight *f, gs_real ux, gs_real uy)
+{
+    gs_real nrm = GS_SQRT(ux * ux + uy * uy);
+    if (!(nrm > GS_R(0.0))) return false;
+    f->up_x = ux / nrm;
+    f->up_y = uy / nrm;
+    return true;
+}
+
+/* Restart the seed's level trackers from ring sample i (from nothing when not held) */
+static NOINLINE void restart_levels(gs_flight *f, uint64_t i)
+{
+    gs_sample_full s_b;
+    const gs_sample_full *s = at(f, i, &s_b);
+    gs_real u = s ? u_of(f, s) : NAN;
+    f->blk_min_cur = finite_r(u) ? u : INFINITY;
+    f->blk_min_prev = f->blk_min_cur;
+    f->blk_t0 = s ? s->t_s : NAN;
+    f->peak_u = -INFINITY;
+    f->n_hist = 0;
 }
 
 /* Close the open candidate. right_alarm: the sample at which contact was
@@ -672,52 +782,26 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
     /* boundary refinement on the up direction of the flight's own acceleration */
     gs_real save_ux = f->up_x, save_uy = f->up_y;
-    if (isfinite(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
+    if (finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
         f->up_x = -r.ax_px_s2 / r.a_px_s2;
         f->up_y = -r.ay_px_s2 / r.a_px_s2;
     }
-    /* the contact samples the boundary model sees end where contact was detected:
-     * further out the ground phase is no longer a constant force */
     uint64_t L = f->fl_first, R = f->fl_last;
-    uint64_t lo = L, hi = R;
-    uint32_t n_left = 0, n_right = 0;
-    uint64_t first_left = L, first_right = R;  /* the first contact sample on each side */
-    if (left_alarm != UINT64_MAX) n_left = contact_run(f, &r, L, -1, &lo, &first_left);
-    if (right_alarm != UINT64_MAX) n_right = contact_run(f, &r, R, +1, &hi, &first_right);
-    double T0 = NAN, T1 = NAN;
-    /* a flight longer than the ring holds has lost its edges: no refinement */
-    if (!held(f, L) || !held(f, R) || !held(f, lo) || !held(f, hi) || !held(f, first_left) || !held(f, first_right))
-        n_left = n_right = 0;
-    gs_real amin = CONTACT_MIN_G * r.a_px_s2;
+    /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
+     * holds a contiguous range; the contact samples lie between L and the newest and
+     * are held, so L tells for all of them.) */
+    bool refine = held(f, L);
     gs_real sig = fit_sigma(f, &r);
     gs_real pen = DROP_PENALTY * sig * sig;
-    /* two or more contact samples with a growing deviation: a constant-force model
-     * past the boundary gives a sub-frame time; one: the midpoint is all we know */
-    if (n_left >= 2)
-        T0 = refine_boundary(f, lo, R, -1, L, lo, amin, TAKEOFF_MAX_G * r.a_px_s2, t_at(f, L), pen, &r);
-    else if (n_left == 1)
-        T0 = 0.5 * (t_at(f, first_left) + t_at(f, L));
-    if (n_right >= 2)
-        T1 = refine_boundary(f, L, hi, +1, R, hi, amin, LANDING_MAX_G * r.a_px_s2, t_at(f, R), pen, &r);
-    else if (n_right == 1)
-        T1 = 0.5 * (t_at(f, first_right) + t_at(f, R));
-    DBG("close: L=%llu R=%llu lo=%llu hi=%llu nl=%u nr=%u T0=%.4f T1=%.4f a=%.1f\n",
+    uint64_t lo, hi;  /* the outermost contact samples */
+    double T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
+    double T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
+    DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%.4f T1=%.4f a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
-        n_left, n_right, T0, T1, r.a_px_s2);
+        T0, T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
-    uint64_t in_lo = lo, in_hi = hi;
-    while (in_lo < in_hi) {
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, in_lo, &s_b);
-        if (s && (!isfinite(T0) ? in_lo >= L : s->t_s > T0)) break;
-        in_lo++;
-    }
-    while (in_hi > in_lo) {
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, in_hi, &s_b);
-        if (s && (!isfinite(T1) ? in_hi <= R : s->t_s < T1)) break;
-        in_hi--;
-    }
+    uint64_t in_lo = trim_edge(f, lo, hi, T0, -1, L);
+    uint64_t in_hi = trim_edge(f, hi, in_lo, T1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
 
@@ -731,6 +815,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
                                  f->keep, &fr);
     trace_fit(f, "final", sf->t_s, sl->t_s, st == GS_OK ? &fr : NULL);
+    if (st != GS_OK) goto done;  /* nothing fits: not a flight worth reporting */
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
@@ -739,17 +824,18 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        if (!s || !(s->w > 0.0f) || !isfinite(s->t_s)) continue;  /* frames missing from the source */
-        if (isfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
+        if (!s || !(s->w > 0.0f) || !finite_d(s->t_s)) continue;  /* frames missing from the source */
+        if (finite_d(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
-        if (st == GS_OK && !gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
+        if (!gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    if (!isfinite(T0)) T0 = sf->t_s - 0.5 * dt;
-    if (!isfinite(T1)) T1 = sl->t_s + 0.5 * dt;
+    double half_dt = 0.5 * dt;
+    if (!finite_d(T0)) T0 = sf->t_s - half_dt;
+    if (!finite_d(T1)) T1 = sl->t_s + half_dt;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -762,19 +848,13 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     j->flight_time_s = T1 - T0;
     j->n_samples = n_in;
     j->n_outliers = n_out;
-    j->a_px_s2 = j->a_px_se_s2 = j->g_dir_deg = j->q_m_per_px = NAN;
-    j->size_px = j->height_m = j->height_se_m = NAN;
-    j->jump_height_m = j->takeoff_velocity_m_s = j->t_apex_s = j->rms_px = NAN;
-    j->accepted = false;
-    j->reason = GS_REJ_NONE;
+    j->height_m = j->height_se_m = NAN;  /* the other fields are all set below (memset: not accepted, no reason) */
 
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
 
-    if (st != GS_OK) {
-        goto done;  /* nothing fits: not a flight worth reporting */
-    } else {
+    {
         gs_real g = f->g_m_s2;
         j->a_px_s2 = fr.a_px_s2;
         j->a_px_se_s2 = fr.a_se_px_s2;
@@ -789,12 +869,12 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         gs_real rise_t = j->t_apex_s - T0;
         j->jump_height_m = GS_R(0.5) * g * rise_t * rise_t;
         j->takeoff_velocity_m_s = g * rise_t;
-        if (isfinite(size)) {
+        if (finite_r(size)) {
             height = size * q;
             j->height_m = height;
             gs_real ra = fr.a_se_px_s2 / fr.a_px_s2;
-            gs_real rs = isfinite(size_se) ? size_se / size : GS_R(0.0);
-            j->height_se_m = height * GS_SQRT((isfinite(ra) ? ra * ra : GS_R(0.0)) + rs * rs);
+            gs_real rs = finite_r(size_se) ? size_se / size : GS_R(0.0);
+            j->height_se_m = height * GS_SQRT((finite_r(ra) ? ra * ra : GS_R(0.0)) + rs * rs);
         }
 
         /* is this a flight at all? (walking bumps, standing, noise) */
@@ -805,7 +885,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
             j->reason = GS_REJ_FEW_SAMPLES;
         else if (max_gap_in > (double)f->cfg->max_gap_s)
             j->reason = GS_REJ_GAP;
-        else if (!isfinite(size))
+        else if (!finite_r(size))
             j->reason = GS_REJ_NO_SIZE;
         else if (fr.rms_px > (gs_real)f->cfg->max_rms_rel * size)
             j->reason = GS_REJ_LARGE_RESIDUAL;
@@ -818,14 +898,14 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
         if (truncated) j->warnings |= GS_WARN_CLIPPED;
-        if (f->n_flights > 0 && isfinite(f->last_g_dir_deg) &&
+        if (f->n_flights > 0 && finite_r(f->last_g_dir_deg) &&
             GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
             j->warnings |= GS_WARN_GRAVITY_TILT;
     }
 
     if (j->accepted) {
         f->last_a_px_s2 = fr.a_px_s2;
-        f->last_g_dir_deg = isfinite(f->last_g_dir_deg)
+        f->last_g_dir_deg = finite_r(f->last_g_dir_deg)
             ? GS_R(0.7) * f->last_g_dir_deg + GS_R(0.3) * fr.g_dir_deg : fr.g_dir_deg;
         /* gravity's direction in the image, from the flights themselves */
         gs_real ux = -fr.ax_px_s2 / fr.a_px_s2, uy = -fr.ay_px_s2 / fr.a_px_s2;
@@ -833,8 +913,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
             ux = GS_R(0.7) * f->up_x + GS_R(0.3) * ux;
             uy = GS_R(0.7) * f->up_y + GS_R(0.3) * uy;
         }
-        gs_real nrm = GS_SQRT(ux * ux + uy * uy);
-        if (nrm > GS_R(0.0)) { f->up_x = ux / nrm; f->up_y = uy / nrm; f->up_from_flight = true; }
+        if (set_up(f, ux, uy)) f->up_from_flight = true;
     }
     f->n_flights++;
     emit(f, &ev);
@@ -844,17 +923,7 @@ done:
      * see the contact samples that follow it */
     f->quiet_from = newest;
     if (land_idx != UINT64_MAX && land_idx < newest) f->quiet_from = land_idx;
-    {
-        /* next seeds start after the landing: restart the level trackers */
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, newest, &s_b);
-        gs_real u = s ? u_of(f, s) : NAN;
-        f->blk_min_cur = isfinite(u) ? u : INFINITY;
-        f->blk_min_prev = f->blk_min_cur;
-        f->blk_t0 = s ? s->t_s : NAN;
-        f->peak_u = -INFINITY;
-        f->n_hist = 0;
-    }
+    restart_levels(f, newest);  /* next seeds start after the landing */
 }
 
 /* ---- the per-sample state machine ------------------------------------------ */
@@ -864,50 +933,59 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 /* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
 static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u)
 {
-    uint64_t k = (uint64_t)CEIL_D(0.1 / frame_dt(f));
+    uint64_t k = (uint64_t)ceil_count(0.1 / frame_dt(f));
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
-    const gs_sample_full *b = at(f, idx - k, &b_b);
-    if (!usable(b) || !(s->t_s > b->t_s)) return NAN;
+    const gs_sample_full *b = usable_at(f, idx - k, &b_b);
+    if (!b || !(s->t_s > b->t_s)) return NAN;
     return GS_FABSR(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
+}
+
+/* keep size in a ring of the last GS_STAND_KEEP */
+static NOINLINE void keep_size(float *ring, uint32_t *n, uint32_t *next, float size_px)
+{
+    ring[*next] = size_px;
+    *next = (*next + 1u) % GS_STAND_KEEP;
+    if (*n < GS_STAND_KEEP) (*n)++;
 }
 
 static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed)
 {
-    if (!isfinite(speed)) return;
-    if (IS_RIGID(f) || !isfinite(s->size_px) || !(s->size_px > 0.0f)) return;
+    if (!finite_r(speed)) return;
+    if (IS_RIGID(f) || !size_ok(s->size_px)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
     if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
-    if (!isfinite(f->still_since)) f->still_since = s->t_s;
+    if (!finite_d(f->still_since)) f->still_since = s->t_s;
     if (s->upright >= LOOSE_UPRIGHT) {
-        f->loose_size[f->loose_next] = s->size_px;
-        f->loose_next = (f->loose_next + 1u) % GS_STAND_KEEP;
-        if (f->loose_n < GS_STAND_KEEP) f->loose_n++;
+        keep_size(f->loose_size, &f->loose_n, &f->loose_next, s->size_px);
     }
     if (!(s->upright >= STAND_UPRIGHT)) return;
     if (s->t_s - f->still_since < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
-    f->stand_size[f->stand_next] = s->size_px;
-    f->stand_next = (f->stand_next + 1u) % GS_STAND_KEEP;
-    if (f->stand_n < GS_STAND_KEEP) f->stand_n++;
+    keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_t = s->t_s;
     /* body axis -> image up, until flights measure gravity directly */
-    if (!f->up_from_flight && isfinite(s->up_x) && isfinite(s->up_y)) {
+    if (!f->up_from_flight && finite_r(s->up_x) && finite_r(s->up_y)) {
         gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
         gs_real ux = (GS_R(1.0) - kw) * f->up_x + kw * (gs_real)s->up_x;
         gs_real uy = (GS_R(1.0) - kw) * f->up_y + kw * (gs_real)s->up_y;
         if (f->up_n == 0) { ux = s->up_x; uy = s->up_y; }
-        gs_real nrm = GS_SQRT(ux * ux + uy * uy);
-        if (nrm > GS_R(0.0)) { f->up_x = ux / nrm; f->up_y = uy / nrm; }
+        set_up(f, ux, uy);
         f->up_n++;
     }
+}
+
+/* the newest standing size (stand_n > 0) */
+static float last_stand_size(const gs_flight *f)
+{
+    return f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
 }
 
 double gs_flight_stand_at(const gs_flight *f, double t_s)
 {
     /* the ring gives times back to the microsecond: same frame within half a millisecond */
     if (!f || f->stand_n == 0 || !(fabs(f->stand_last_t - t_s) < 5e-4)) return NAN;
-    return (gs_real)f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
+    return (gs_real)last_stand_size(f);
 }
 
 void gs_flight_forget_body(gs_flight *f)
@@ -923,10 +1001,9 @@ void gs_flight_forget_body(gs_flight *f)
 static gs_real size_ref(const gs_flight *f, const gs_sample_full *s)
 {
     if (!IS_RIGID(f) && f->stand_n > 0) { /* a rigid object has no standing sizes */
-        uint32_t i = (f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP;
-        return f->stand_size[i];
+        return last_stand_size(f);
     }
-    return (isfinite(s->size_px) && s->size_px > 0.0f) ? (gs_real)s->size_px : NAN;
+    return size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
 }
 
 static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
@@ -954,14 +1031,15 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
      * jump series would otherwise pass for noise) */
     gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
     /* size_ref(f, s) again would be sz: nothing between changes what it reads */
-    bool still = isfinite(speed) && (!isfinite(sz) || speed < STAND_SPEED_REL * sz);
+    /* sz is positive or NaN (unknown: any finite speed counts) */
+    bool still = finite_r(speed) && !(speed >= STAND_SPEED_REL * sz);
     /* noise: a robust running mean of |second difference| on the ground, started from
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
         f->noise_init[f->noise_n++] = (float)GS_FABSR(d2);
         if (f->noise_n == NOISE_INIT_N) {
             float tmp[NOISE_INIT_N];
-            for (uint32_t i = 0; i < NOISE_INIT_N; i++) tmp[i] = f->noise_init[i];
+            memcpy(tmp, f->noise_init, sizeof tmp);
             gs_real med = median_f(tmp, NOISE_INIT_N);
             f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = 1.652 s */
             if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
@@ -974,7 +1052,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     update_standing(f, s, speed);
 
     /* recent minimum over two half-second blocks */
-    if (!isfinite(f->blk_t0)) f->blk_t0 = tm;
+    if (!finite_d(f->blk_t0)) f->blk_t0 = tm;
     if (tm - f->blk_t0 > 0.5) {
         f->blk_min_prev = f->blk_min_cur;
         f->blk_min_cur = INFINITY;
@@ -985,17 +1063,17 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 
     gs_real nz = noise_floor(f);
     gs_real thr = SEED_RISE_NOISE * nz;
-    if (isfinite(sz) && SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;
+    if (SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;  /* false for an unknown (NaN) size */
     DBG("g t=%.3f um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", tm, um, umin, thr, nz, sz, f->peak_u);
     /* a peak counts once it rose thr above the recent minimum; the drop that
      * confirms it as an apex seeds a flight, however far it has fallen by then */
-    if (!isfinite(f->peak_u)) {
+    if (!finite_r(f->peak_u)) {
         if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; }
         return;
     }
     if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; return; }
     gs_real drop = SEED_DROP_NOISE * nz;
-    if (isfinite(sz) && GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
+    if (GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
     if (f->peak_u - um <= drop) return;
     uint64_t apex = f->peak_idx;
     double apex_t = f->peak_t;
@@ -1005,8 +1083,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         /* samples after the core that arrived meanwhile are tested in order */
         for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
             gs_sample_full p_b;
-            const gs_sample_full *p = at(f, i, &p_b);
-            if (usable(p)) airborne_sample(f, i, p);
+            const gs_sample_full *p = usable_at(f, i, &p_b);
+            if (p) airborne_sample(f, i, p);
         }
     }
 }
@@ -1014,7 +1092,8 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_full *s)
 {
     /* the running fit may hold samples past the edge: rebuild it over the flight */
-    refit_range(f, f->fl_first, f->fl_last);
+    gs_fit_result r;
+    refit_range(f, f->fl_first, f->fl_last, &r);
     close_candidate(f, idx, alarm, false);
     set_state(f, GS_FS_GROUND, s->t_s);
 }
@@ -1023,10 +1102,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
-    gs_sample_full seed_b;
-    const gs_sample_full *seed = at(f, f->seed_idx, &seed_b);
-    if (gs_fit_solve(&f->fit, &r) != GS_OK ||
-        (seed && s->t_s - seed->t_s > (double)f->cfg->max_flight_s)) {
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_s, t_at(f, f->seed_idx), f->cfg->max_flight_s)) {
         land(f, idx, UINT64_MAX, s);
         return;
     }
@@ -1037,7 +1113,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     uint64_t k = idx - f->fl_last - 1;  /* position among the pending samples */
     if (k >= 32) { land(f, idx, UINT64_MAX, s); return; }
     gs_real z;
-    bool ok = test_sample(f, &f->fit, &r, s, &z);
+    bool ok = test_sample(f, &r, s, &z);
     DBG("t=%.4f ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", s->t_s, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
         if (++f->outliers_run >= 3) land(f, idx, UINT64_MAX, s);
@@ -1046,9 +1122,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    gs_sample_full edge_b;
-    const gs_sample_full *edge = at(f, f->fl_last, &edge_b);
-    if (f->cusum > GS_R(0.0) && edge && s->t_s - edge->t_s > (double)f->cfg->landing_latency_s) {
+    if (f->cusum > GS_R(0.0) && span_over(s->t_s, t_at(f, f->fl_last), f->cfg->landing_latency_s)) {
         land(f, idx, idx, s);
         return;
     }
@@ -1067,9 +1141,9 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         /* everything pending was flight after all: take it in */
         for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
             gs_sample_full p_b;
-            const gs_sample_full *p = at(f, j, &p_b);
-            if (usable(p) && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
-                gs_fit_add(&f->fit, p->t_s, p->x_px, p->y_px, p->w);
+            const gs_sample_full *p = usable_at(f, j, &p_b);
+            if (p && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
+                fit_add(f, p);
         }
         f->fl_last = idx;
         f->pend_ok = 0;
@@ -1087,23 +1161,20 @@ void gs_flight_update(gs_flight *f)
         const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
-        bool present = s && s->w > 0.0f && isfinite(s->t_s);
+        bool present = s && s->w > 0.0f && finite_d(s->t_s);
         if (present && !usable(s)) { f->last_t_s = s->t_s; continue; }
         if (!present) continue;
-        if (isfinite(f->last_t_s)) {
+        if (finite_d(f->last_t_s)) {
             double dt = s->t_s - f->last_t_s;
             if (dt > GS_R(0.0)) {
-                if (!isfinite(f->dt_med_s)) f->dt_med_s = dt;
+                if (!finite_d(f->dt_med_s)) f->dt_med_s = dt;
                 else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
             }
             if (dt > (double)f->cfg->max_gap_s) {
                 if (f->state == GS_FS_AIRBORNE) {
                     close_candidate(f, f->last_idx, UINT64_MAX, true);
                 }
-                f->n_hist = 0;
-                f->peak_u = -INFINITY;
-                f->blk_min_cur = f->blk_min_prev = INFINITY;
-                f->blk_t0 = NAN;
+                restart_levels(f, UINT64_MAX);  /* never held: from nothing */
                 set_state(f, GS_FS_GROUND, s->t_s);
             }
         }
