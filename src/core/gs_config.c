@@ -8,6 +8,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "gs_dbits.h"
+
 #define CFG_MAX_LINE 255u
 
 /* ------------------------------------------------------------- utilities */
@@ -233,87 +235,122 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
 
 typedef enum { T_DBL, T_DBL_AUTO, T_FLT, T_U32, T_U32_POW2 } num_type;
 
+/* A numeric key: its range in thousandths (milli / 1000.0, one correctly rounded
+ * division, is the double nearest the decimal bound, as the literal would be:
+ * 8 bytes a key instead of two doubles) and where it is stored. */
 typedef struct {
     const char *key;
-    num_type type;
-    double lo, hi;
-    size_t off;
+    int32_t lo_milli, hi_milli;
+    uint8_t type; /* num_type; from T_U32 on an integer */
+    uint8_t off;  /* offsetof in gs_core_config */
 } num_key;
+
+#define MILLI(x) ((int32_t)((x) * 1000 + ((x) < 0 ? -0.5 : 0.5)))
+#define NK(name, type, lo, hi) {#name, MILLI(lo), MILLI(hi), type, offsetof(gs_core_config, name)}
+_Static_assert(sizeof(gs_core_config) <= 256, "num_key.off is 8 bits");
 
 /* every numeric [core] key with its range (docs/config.md lists the same) */
 static const num_key k_num_keys[] = {
-    {"g_m_s2", T_DBL_AUTO, 9.7, 9.9, offsetof(gs_core_config, g_m_s2)},
-    {"latitude_deg", T_DBL_AUTO, -90.0, 90.0, offsetof(gs_core_config, latitude_deg)},
-    {"altitude_m", T_DBL, -500.0, 9000.0, offsetof(gs_core_config, altitude_m)},
-    {"min_conf", T_FLT, 0.0, 1.0, offsetof(gs_core_config, min_conf)},
-    {"ring_capacity", T_U32_POW2, 64.0, 65536.0, offsetof(gs_core_config, ring_capacity)},
-    {"min_flight_s", T_FLT, 0.05, 2.0, offsetof(gs_core_config, min_flight_s)},
-    {"max_flight_s", T_FLT, 0.1, 5.0, offsetof(gs_core_config, max_flight_s)},
-    {"min_samples", T_U32, 4.0, 1000.0, offsetof(gs_core_config, min_samples)},
-    {"max_rms_rel", T_FLT, 0.001, 1.0, offsetof(gs_core_config, max_rms_rel)},
-    {"max_a_se_rel", T_FLT, 0.001, 1.0, offsetof(gs_core_config, max_a_se_rel)},
-    {"size_min_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_min_m)},
-    {"size_max_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_max_m)},
-    {"max_gap_s", T_FLT, 0.01, 2.0, offsetof(gs_core_config, max_gap_s)},
-    {"landing_latency_s", T_FLT, 0.02, 1.0, offsetof(gs_core_config, landing_latency_s)},
-    {"session_absence_s", T_FLT, 0.5, 600.0, offsetof(gs_core_config, session_absence_s)},
-    {"session_new_body_rel", T_FLT, 0.03, 0.5, offsetof(gs_core_config, session_new_body_rel)},
+    NK(g_m_s2, T_DBL_AUTO, 9.7, 9.9),
+    NK(latitude_deg, T_DBL_AUTO, -90, 90),
+    NK(altitude_m, T_DBL, -500, 9000),
+    NK(min_conf, T_FLT, 0, 1),
+    NK(ring_capacity, T_U32_POW2, 64, 65536),
+    NK(min_flight_s, T_FLT, 0.05, 2),
+    NK(max_flight_s, T_FLT, 0.1, 5),
+    NK(min_samples, T_U32, 4, 1000),
+    NK(max_rms_rel, T_FLT, 0.001, 1),
+    NK(max_a_se_rel, T_FLT, 0.001, 1),
+    NK(size_min_m, T_FLT, 0, 10),
+    NK(size_max_m, T_FLT, 0, 10),
+    NK(max_gap_s, T_FLT, 0.01, 2),
+    NK(landing_latency_s, T_FLT, 0.02, 1),
+    NK(session_absence_s, T_FLT, 0.5, 600),
+    NK(session_new_body_rel, T_FLT, 0.03, 0.5),
 };
 
 void gs_core_config_default(gs_core_config *c)
 {
-    if (!c) return;
-    memset(c, 0, sizeof *c);
-    c->g_m_s2 = NAN;
-    c->latitude_deg = NAN;
-    c->altitude_m = 0.0;
-    c->mass_table = GS_MASS_DELEVA;
-    c->stature = GS_STATURE_ANTHRO;
-    c->min_conf = 0.1f;  /* blurred fast limbs come with low confidence but usable positions */
-    c->fit_method = GS_FIT_IRLS;
-    c->ring_capacity = 512u;
-    c->min_flight_s = 0.12f;
-    c->max_flight_s = 1.5f;
-    c->min_samples = 6u;
-    c->max_rms_rel = 0.03f;
-    c->max_a_se_rel = 0.15f;
-    c->size_min_m = 0.3f;
-    c->size_max_m = 2.6f;
-    c->max_gap_s = 0.2f;
-    c->landing_latency_s = 0.2f;
-    c->session_absence_s = 2.5f;
-    c->session_new_body_rel = 0.12f;
-    c->format = GS_WITH_JSON ? GS_FMT_JSON : GS_FMT_NMEA; /* the one built in (gs_features.h) */
+    static const gs_core_config k_default = {
+        .g_m_s2 = NAN,
+        .latitude_deg = NAN,
+        .altitude_m = 0.0,
+        .mass_table = GS_MASS_DELEVA,
+        .stature = GS_STATURE_ANTHRO,
+        .min_conf = 0.1f, /* blurred fast limbs come with low confidence but usable positions */
+        .fit_method = GS_FIT_IRLS,
+        .ring_capacity = 512u,
+        .min_flight_s = 0.12f,
+        .max_flight_s = 1.5f,
+        .min_samples = 6u,
+        .max_rms_rel = 0.03f,
+        .max_a_se_rel = 0.15f,
+        .size_min_m = 0.3f,
+        .size_max_m = 2.6f,
+        .max_gap_s = 0.2f,
+        .landing_latency_s = 0.2f,
+        .session_absence_s = 2.5f,
+        .session_new_body_rel = 0.12f,
+        .format = GS_WITH_JSON ? GS_FMT_JSON : GS_FMT_NMEA, /* the one built in (gs_features.h) */
+    };
+    if (c) *c = k_default;
+}
+
+static double bound(int32_t milli) { return (double)milli / 1000.0; }
+
+/* a bound as gs_num_fmt_sig(.., 6) writes it: at most 3 decimals, trailing zeros cut */
+static void append_bound(char *msg, size_t cap, int32_t milli)
+{
+    char t[32];
+    size_t n = gs_num_fmt_fixed(t, sizeof t, bound(milli), 3);
+    while (t[n - 1u] == '0') n--;
+    if (t[n - 1u] == '.') n--;
+    t[n] = '\0';
+    append(msg, cap, t);
 }
 
 static void range_msg(char *msg, size_t cap, const num_key *k)
 {
-    char lo[32], hi[32];
-    gs_num_fmt_sig(lo, sizeof lo, k->lo, 6);
-    gs_num_fmt_sig(hi, sizeof hi, k->hi, 6);
     copy_cstr(msg, cap, k->type == T_U32_POW2 ? "must be a power of two in " : "must be within ");
-    append(msg, cap, lo);
+    append_bound(msg, cap, k->lo_milli);
     append(msg, cap, "..");
-    append(msg, cap, hi);
+    append_bound(msg, cap, k->hi_milli);
 }
 
 static bool is_pow2(uint32_t v) { return v && !(v & (v - 1u)); }
 
+/* an integer key's value within its (whole-number) range */
+static bool int_ok(const num_key *k, int64_t x)
+{
+    return x >= k->lo_milli / 1000 && x <= k->hi_milli / 1000 && (k->type != T_U32_POW2 || is_pow2((uint32_t)x));
+}
+
+/* lo <= x <= hi; a float field holds the decimal bounds only as floats */
+static bool dbl_ok(const num_key *k, double x, bool as_float)
+{
+    double lo = bound(k->lo_milli), hi = bound(k->hi_milli);
+    if (as_float) {
+        lo = (double)(float)lo;
+        hi = (double)(float)hi;
+    }
+    return x >= lo && x <= hi;
+}
+
 static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, size_t n, char *msg, size_t cap)
 {
-    unsigned char *base = (unsigned char *)c;
-    if (k->type == T_U32 || k->type == T_U32_POW2) {
+    unsigned char *field = (unsigned char *)c + k->off;
+    if (k->type >= T_U32) {
         long x;
         if (!gs_num_parse_int(v, n, &x)) {
             copy_cstr(msg, cap, "not an integer");
             return GS_EINVAL;
         }
-        if ((double)x < k->lo || (double)x > k->hi || (k->type == T_U32_POW2 && !is_pow2((uint32_t)x))) {
+        if (!int_ok(k, x)) {
             range_msg(msg, cap, k);
             return GS_ERANGE;
         }
         uint32_t u = (uint32_t)x;
-        memcpy(base + k->off, &u, sizeof u);
+        memcpy(field, &u, sizeof u);
         return GS_OK;
     }
     double x;
@@ -324,16 +361,16 @@ static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, siz
             copy_cstr(msg, cap, k->type == T_DBL_AUTO ? "not a number (or auto)" : "not a number");
             return GS_EINVAL;
         }
-        if (!(x >= k->lo && x <= k->hi)) {
+        if (!dbl_ok(k, x, false)) {
             range_msg(msg, cap, k);
             return GS_ERANGE;
         }
     }
     if (k->type == T_FLT) {
         float f = (float)x;
-        memcpy(base + k->off, &f, sizeof f);
+        memcpy(field, &f, sizeof f);
     } else {
-        memcpy(base + k->off, &x, sizeof x);
+        memcpy(field, &x, sizeof x);
     }
     return GS_OK;
 }
@@ -387,25 +424,22 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
     if (err) memset(err, 0, sizeof *err);
     if (!c) return check_fail(err, GS_EINVAL, "", "no config");
     /* a config filled in by code gets the same range checks as a parsed one */
-    const unsigned char *base = (const unsigned char *)c;
     for (size_t i = 0; i < sizeof k_num_keys / sizeof k_num_keys[0]; i++) {
         const num_key *k = &k_num_keys[i];
-        double x;
+        const unsigned char *field = (const unsigned char *)c + k->off;
         bool ok;
-        if (k->type == T_U32 || k->type == T_U32_POW2) {
+        if (k->type >= T_U32) {
             uint32_t u;
-            memcpy(&u, base + k->off, sizeof u);
-            x = (double)u;
-            ok = x >= k->lo && x <= k->hi && (k->type != T_U32_POW2 || is_pow2(u));
+            memcpy(&u, field, sizeof u);
+            ok = int_ok(k, u);
         } else if (k->type == T_FLT) {
             float f;
-            memcpy(&f, base + k->off, sizeof f);
-            x = (double)f;
-            /* a float holds the decimal bound only approximately */
-            ok = x >= (double)(float)k->lo && x <= (double)(float)k->hi;
+            memcpy(&f, field, sizeof f);
+            ok = dbl_ok(k, (double)f, true);
         } else {
-            memcpy(&x, base + k->off, sizeof x);
-            ok = (k->type == T_DBL_AUTO && isnan(x)) || (x >= k->lo && x <= k->hi);
+            double x;
+            memcpy(&x, field, sizeof x);
+            ok = (k->type == T_DBL_AUTO && gs_disnan(x)) || dbl_ok(k, x, false);
         }
         if (!ok) {
             char msg[64];
