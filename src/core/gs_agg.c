@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "gravscale/gs_agg.h"
+#include "gs_dbits.h"
 
 /* With one flight the between-flight scatter cannot be seen; a per-flight
  * relative scatter (pose, size and outlier flights the fit's SE misses) is
@@ -88,12 +89,14 @@ void gs_agg_add(gs_agg *a, double value_m, double se_m)
         return;
     }
     /* A flight without a usable size was a flight that failed: count it as rejected. */
-    if (!isfinite(value_m) || !(value_m > 0.0)) {
+    if (!gs_dpositive(value_m)) {
         a->n_rejected++;
         return;
     }
     a->value[a->next] = (float)value_m;
-    a->se[a->next] = (isfinite(se_m) && se_m >= 0.0) ? (float)se_m : NAN; /* unknown SE kept as NaN */
+    /* finite and >= 0 (-0 included); an unknown SE is kept as NaN */
+    bool se_ok = gs_dbits(se_m) < GS_DBITS_INF || gs_dbits(se_m) == GS_DBITS_SIGN;
+    a->se[a->next] = se_ok ? (float)se_m : NAN;
     a->next = (a->next + 1u) % GS_AGG_MAX;
     if (a->held < GS_AGG_MAX) {
         a->held++;

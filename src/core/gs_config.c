@@ -66,74 +66,64 @@ static void trim(const char **s, size_t *n)
     while (*n && is_blank((*s)[*n - 1u])) (*n)--;
 }
 
-/* One line without its line ending. */
-static ln_tok lex_line(const char *s, size_t n)
+/* One line without its line ending into *t (kind, names, LN_ERROR's reason). */
+static void lex_line(const char *s, size_t n, ln_tok *t)
 {
-    ln_tok t = {LN_EMPTY, NULL, 0, NULL, 0, NULL};
+    *t = (ln_tok){LN_EMPTY, NULL, 0, NULL, 0, NULL};
     trim(&s, &n);
-    if (n == 0 || s[0] == '#' || s[0] == ';') return t;
+    if (n == 0 || s[0] == '#' || s[0] == ';') return;
+    t->kind = LN_ERROR;
     if (s[0] == '[') {
         size_t rb = 1;
         while (rb < n && s[rb] != ']') rb++;
         if (rb == n) {
-            t.kind = LN_ERROR;
-            t.err = "section header without ']'";
-            return t;
+            t->err = "section header without ']'";
+            return;
         }
         /* after ']' only blanks or a comment */
-        for (size_t i = rb + 1u; i < n; i++) {
-            if (s[i] == '#' || s[i] == ';') break;
+        for (size_t i = rb + 1u; i < n && s[i] != '#' && s[i] != ';'; i++) {
             if (!is_blank(s[i])) {
-                t.kind = LN_ERROR;
-                t.err = "text after section header";
-                return t;
+                t->err = "text after section header";
+                return;
             }
         }
-        t.a = s + 1;
-        t.an = rb - 1u;
-        trim(&t.a, &t.an);
-        if (t.an == 0) {
-            t.kind = LN_ERROR;
-            t.err = "empty section name";
-            return t;
-        }
-        t.kind = LN_SECTION;
-        return t;
+        t->a = s + 1;
+        t->an = rb - 1u;
+        trim(&t->a, &t->an);
+        if (t->an == 0) t->err = "empty section name";
+        else t->kind = LN_SECTION;
+        return;
     }
     size_t eq = 0;
     while (eq < n && s[eq] != '=') eq++;
     if (eq == n) {
-        t.kind = LN_ERROR;
-        t.err = "expected 'key = value'";
-        return t;
+        t->err = "expected 'key = value'";
+        return;
     }
-    t.a = s;
-    t.an = eq;
-    trim(&t.a, &t.an);
-    t.kind = LN_KEY;
-    if (t.an == 0) {
-        t.kind = LN_ERROR;
-        t.err = "empty key";
-        return t;
+    t->a = s;
+    t->an = eq;
+    trim(&t->a, &t->an);
+    if (t->an == 0) {
+        t->err = "empty key";
+        return;
     }
-    for (size_t i = 0; i < t.an; i++) {
-        if (!key_char_ok(t.a[i])) {
-            t.kind = LN_ERROR;
-            t.err = "bad character in key";
-            return t;
+    for (size_t i = 0; i < t->an; i++) {
+        if (!key_char_ok(t->a[i])) {
+            t->err = "bad character in key";
+            return;
         }
     }
-    t.b = s + eq + 1u;
-    t.bn = n - eq - 1u;
+    t->kind = LN_KEY;
+    t->b = s + eq + 1u;
+    t->bn = n - eq - 1u;
     /* an inline comment starts at # or ; preceded by a blank */
-    for (size_t i = 1; i < t.bn; i++) {
-        if ((t.b[i] == '#' || t.b[i] == ';') && is_blank(t.b[i - 1u])) {
-            t.bn = i;
+    for (size_t i = 1; i < t->bn; i++) {
+        if ((t->b[i] == '#' || t->b[i] == ';') && is_blank(t->b[i - 1u])) {
+            t->bn = i;
             break;
         }
     }
-    trim(&t.b, &t.bn);
-    return t;
+    trim(&t->b, &t->bn);
 }
 
 /* next line of text[pos..len): [*ls, *le) without CR/LF; returns the next pos */
@@ -156,7 +146,8 @@ static bool seen_before(const char *text, size_t upto, const char *sec, size_t s
     while (pos < upto) {
         size_t ls, le;
         pos = next_line(text, upto, pos, &ls, &le);
-        ln_tok t = lex_line(text + ls, le - ls);
+        ln_tok t;
+        lex_line(text + ls, le - ls, &t);
         if (t.kind == LN_SECTION) {
             cur = t.a;
             curn = t.an;
@@ -185,21 +176,27 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
     memset(err, 0, sizeof *err);
     if (!text && len) return fail(err, GS_EINVAL, 0, NULL, 0, NULL, 0, "no text");
     const gs_cfg_section *cur = NULL;
-    const char *cur_name = NULL;
-    size_t cur_n = 0;
+    const char *cur_name = NULL, *key = NULL; /* where an error is: section and key */
+    size_t cur_n = 0, key_n = 0;
+    gs_status st = GS_OK;
+    const char *why = NULL; /* NULL: the handler's message */
     uint32_t line = 0;
-    size_t pos = 0;
-    while (pos < len) {
+    for (size_t pos = 0; pos < len && st == GS_OK;) {
         size_t ls, le;
-        size_t next = next_line(text, len, pos, &ls, &le);
+        pos = next_line(text, len, pos, &ls, &le);
         line++;
-        if (memchr(text + ls, '\0', le - ls) || (le < len && text[le] == '\0'))
-            return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, "NUL byte in text");
-        if (le - ls > CFG_MAX_LINE)
-            return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, "line longer than 255 characters");
-        ln_tok t = lex_line(text + ls, le - ls);
-        if (t.kind == LN_ERROR) return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, t.err);
-        if (t.kind == LN_SECTION) {
+        key = NULL;
+        key_n = 0;
+        ln_tok t;
+        lex_line(text + ls, le - ls, &t);
+        st = GS_ESYNTAX;
+        if (memchr(text + ls, '\0', le - ls) || (le < len && text[le] == '\0')) {
+            why = "NUL byte in text";
+        } else if (le - ls > CFG_MAX_LINE) {
+            why = "line longer than 255 characters";
+        } else if (t.kind == LN_ERROR) {
+            why = t.err;
+        } else if (t.kind == LN_SECTION) {
             cur = NULL;
             for (size_t i = 0; sections && i < n_sections; i++) {
                 if (sections[i].name && is_lit(t.a, t.an, sections[i].name)) {
@@ -207,26 +204,31 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
                     break;
                 }
             }
-            if (!cur) return fail(err, GS_ENOKEY, line, t.a, t.an, NULL, 0, "unknown section");
             cur_name = t.a;
             cur_n = t.an;
+            st = cur ? GS_OK : GS_ENOKEY;
+            why = "unknown section";
         } else if (t.kind == LN_KEY) {
-            if (!cur) return fail(err, GS_ESYNTAX, line, NULL, 0, t.a, t.an, "key before any [section]");
-            if (seen_before(text, ls, cur_name, cur_n, t.a, t.an))
-                return fail(err, GS_EINVAL, line, cur_name, cur_n, t.a, t.an, "duplicate key");
-            err->msg[0] = '\0';
-            gs_status st = cur->fn ? cur->fn(cur->ctx, t.a, t.an, t.b, t.bn, err->msg, sizeof err->msg)
-                                   : GS_ENOKEY;
-            if (st != GS_OK) {
-                const char *why = err->msg[0] ? NULL
-                                  : st == GS_ENOKEY ? "unknown key"
-                                  : st == GS_ERANGE ? "value out of range"
-                                                    : "bad value";
-                return fail(err, st, line, cur_name, cur_n, t.a, t.an, why);
+            key = t.a;
+            key_n = t.an;
+            if (!cur) {
+                why = "key before any [section]";
+            } else if (seen_before(text, ls, cur_name, cur_n, t.a, t.an)) {
+                st = GS_EINVAL;
+                why = "duplicate key";
+            } else {
+                err->msg[0] = '\0';
+                st = cur->fn ? cur->fn(cur->ctx, t.a, t.an, t.b, t.bn, err->msg, sizeof err->msg) : GS_ENOKEY;
+                why = err->msg[0] ? NULL
+                      : st == GS_ENOKEY ? "unknown key"
+                      : st == GS_ERANGE ? "value out of range"
+                                        : "bad value";
             }
+        } else {
+            st = GS_OK;
         }
-        pos = next;
     }
+    if (st != GS_OK) return fail(err, st, line, cur_name, cur_n, key, key_n, why);
     err->msg[0] = '\0'; /* a handler may have left text on success */
     return GS_OK;
 }
@@ -375,6 +377,37 @@ static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, siz
     return GS_OK;
 }
 
+/* the [core] keys that take a name, in the order of set_name and name_value */
+static const struct {
+    const char *key, *expected, *unknown;
+    uint8_t max; /* the largest valid enum value */
+} k_name_keys[] = {
+    {"mass_table", "expected deleva, clauser or dempster", "unknown mass table", GS_MASS_DEMPSTER},
+    {"stature", "expected anthro or nose_ankle_1.17", "unknown stature method", GS_STATURE_NOSE_ANKLE_117},
+    {"fit", "expected irls, ransac or plain", "unknown fit method", GS_FIT_PLAIN},
+    {"format", "expected json or nmea", "unknown format", GS_FMT_NMEA},
+};
+
+static bool set_name(gs_core_config *c, size_t i, const char *v, size_t n)
+{
+    switch (i) {
+    case 0: return gs_mass_table_from_name(v, n, &c->mass_table);
+    case 1: return gs_stature_method_from_name(v, n, &c->stature);
+    case 2: return gs_fit_method_from_name(v, n, &c->fit_method);
+    default: return gs_format_from_name(v, n, &c->format);
+    }
+}
+
+static unsigned name_value(const gs_core_config *c, size_t i)
+{
+    switch (i) {
+    case 0: return (unsigned)c->mass_table;
+    case 1: return (unsigned)c->stature;
+    case 2: return (unsigned)c->fit_method;
+    default: return (unsigned)c->format;
+    }
+}
+
 gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len, const char *value, size_t value_len,
                              char *msg, size_t cap)
 {
@@ -384,24 +417,10 @@ gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len, const c
     trim(&value, &value_len);
     for (size_t i = 0; i < sizeof k_num_keys / sizeof k_num_keys[0]; i++)
         if (is_lit(key, key_len, k_num_keys[i].key)) return set_num(c, &k_num_keys[i], value, value_len, msg, cap);
-    if (is_lit(key, key_len, "mass_table")) {
-        if (gs_mass_table_from_name(value, value_len, &c->mass_table)) return GS_OK;
-        copy_cstr(msg, cap, "expected deleva, clauser or dempster");
-        return GS_EINVAL;
-    }
-    if (is_lit(key, key_len, "stature")) {
-        if (gs_stature_method_from_name(value, value_len, &c->stature)) return GS_OK;
-        copy_cstr(msg, cap, "expected anthro or nose_ankle_1.17");
-        return GS_EINVAL;
-    }
-    if (is_lit(key, key_len, "fit")) {
-        if (gs_fit_method_from_name(value, value_len, &c->fit_method)) return GS_OK;
-        copy_cstr(msg, cap, "expected irls, ransac or plain");
-        return GS_EINVAL;
-    }
-    if (is_lit(key, key_len, "format")) {
-        if (gs_format_from_name(value, value_len, &c->format)) return GS_OK;
-        copy_cstr(msg, cap, "expected json or nmea");
+    for (size_t i = 0; i < sizeof k_name_keys / sizeof k_name_keys[0]; i++) {
+        if (!is_lit(key, key_len, k_name_keys[i].key)) continue;
+        if (set_name(c, i, value, value_len)) return GS_OK;
+        copy_cstr(msg, cap, k_name_keys[i].expected);
         return GS_EINVAL;
     }
     copy_cstr(msg, cap, "unknown key");
@@ -432,14 +451,16 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
             uint32_t u;
             memcpy(&u, field, sizeof u);
             ok = int_ok(k, u);
-        } else if (k->type == T_FLT) {
-            float f;
-            memcpy(&f, field, sizeof f);
-            ok = dbl_ok(k, (double)f, true);
         } else {
             double x;
-            memcpy(&x, field, sizeof x);
-            ok = (k->type == T_DBL_AUTO && gs_disnan(x)) || dbl_ok(k, x, false);
+            if (k->type == T_FLT) {
+                float f;
+                memcpy(&f, field, sizeof f);
+                x = (double)f;
+            } else {
+                memcpy(&x, field, sizeof x);
+            }
+            ok = (k->type == T_DBL_AUTO && gs_disnan(x)) || dbl_ok(k, x, k->type == T_FLT);
         }
         if (!ok) {
             char msg[64];
@@ -447,13 +468,8 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
             return check_fail(err, GS_ERANGE, k->key, msg);
         }
     }
-    if ((unsigned)c->mass_table > (unsigned)GS_MASS_DEMPSTER)
-        return check_fail(err, GS_EINVAL, "mass_table", "unknown mass table");
-    if ((unsigned)c->stature > (unsigned)GS_STATURE_NOSE_ANKLE_117)
-        return check_fail(err, GS_EINVAL, "stature", "unknown stature method");
-    if ((unsigned)c->fit_method > (unsigned)GS_FIT_PLAIN)
-        return check_fail(err, GS_EINVAL, "fit", "unknown fit method");
-    if ((unsigned)c->format > (unsigned)GS_FMT_NMEA) return check_fail(err, GS_EINVAL, "format", "unknown format");
+    for (size_t i = 0; i < sizeof k_name_keys / sizeof k_name_keys[0]; i++)
+        if (name_value(c, i) > k_name_keys[i].max) return check_fail(err, GS_EINVAL, k_name_keys[i].key, k_name_keys[i].unknown);
     if (!(c->min_flight_s < c->max_flight_s))
         return check_fail(err, GS_ERANGE, "max_flight_s", "max_flight_s must exceed min_flight_s");
     if (!(c->size_min_m < c->size_max_m))
