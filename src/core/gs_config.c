@@ -491,7 +491,8 @@ double gs_gravity_m_s2(double latitude_deg, double altitude_m)
 double gs_core_config_g(const gs_core_config *c)
 {
     if (!c) return 9.81;
-    if (isfinite(c->g_m_s2)) return c->g_m_s2;
-    if (isfinite(c->latitude_deg)) return gs_gravity_m_s2(c->latitude_deg, isfinite(c->altitude_m) ? c->altitude_m : 0.0);
+    if (gs_dfinite(c->g_m_s2)) return c->g_m_s2;
+    if (gs_dfinite(c->latitude_deg))
+        return gs_gravity_m_s2(c->latitude_deg, gs_dfinite(c->altitude_m) ? c->altitude_m : 0.0);
     return 9.81;
 }

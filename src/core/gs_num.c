@@ -291,8 +291,8 @@ static bool parse_slow(const char *s, size_t mant_len, int64_t exp10_in, bool ne
     return round_to_double(q, sticky, sh, neg, out);
 }
 
-/* 10^k for 0 <= k <= 22: every product is an exact double, so this is the
- * literal (no 184-byte table) */
+/* 10^k: for k <= 22 every product is an exact double, so this is the literal
+ * (no 184-byte table) */
 static double pow10_exact(int k)
 {
     double p = 1.0;
@@ -305,10 +305,13 @@ static double pow10_exact(int k)
  * m <= 2^53 and |e10| <= 22 it is the one rounding of the exact fast path. */
 static bool scale_pow10(uint64_t m, int e10, bool neg, double *out)
 {
-    double r = (double)m;
-    for (; e10 > 22; e10 -= 22) r *= 1e22;
-    for (; e10 < -22 && r != 0.0; e10 += 22) r /= 1e22;
-    if (e10 >= -22) r = e10 < 0 ? r / pow10_exact(-e10) : r * pow10_exact(e10);
+    double r = (double)m; /* m > 0 */
+    bool down = e10 < 0;
+    int k = down ? -e10 : e10;
+    /* 10^22 at a time; an underflow to 0 stays 0 (and 0 / 10^k is 0) */
+    for (; k > 22 && r != 0.0; k -= 22) r = down ? r / 1e22 : r * 1e22;
+    double p = pow10_exact(k);
+    r = down ? r / p : r * p;
     if (!gs_dfinite(r)) return false;
     *out = neg ? -r : r;
     return true;

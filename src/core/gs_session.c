@@ -111,9 +111,6 @@ void gs_session_jump(gs_session *s, const gs_ev_jump *j)
     tally(j->takeoff_velocity_m_s, &s->sum_v_m_s, &s->n_v, NULL);
 }
 
-/* sum / n, NaN when nothing was counted */
-static double mean_or_nan(double sum, uint32_t n) { return n ? sum / (double)n : NAN; }
-
 void gs_session_event(const gs_session *s, bool ended, const char *reason, const gs_ev_height *stature,
                       uint32_t track, gs_event *ev)
 {
@@ -127,8 +124,7 @@ void gs_session_event(const gs_session *s, bool ended, const char *reason, const
     e->t_start_s = s->t_start_s;
     e->t_end_s = ended ? s->t_seen_s : NAN;
     e->stature_m = e->ci95_lo_m = e->ci95_hi_m = NAN;
-    e->best_jump_m = e->best_flight_s = NAN;
-    e->mean_jump_m = e->mean_flight_s = e->mean_takeoff_velocity_m_s = NAN;
+    e->best_jump_m = e->mean_jump_m = e->best_flight_s = e->mean_flight_s = e->mean_takeoff_velocity_m_s = NAN;
     e->n_jumps = s->n_jumps;
     e->n_rejected = s->n_rejected;
     if (!ended) return;
@@ -139,9 +135,9 @@ void gs_session_event(const gs_session *s, bool ended, const char *reason, const
     }
     e->best_jump_m = s->best_jump_m;
     e->best_flight_s = s->best_flight_s;
-    e->mean_jump_m = mean_or_nan(s->sum_jump_m, s->n_jump_h);
-    e->mean_flight_s = mean_or_nan(s->sum_flight_s, s->n_flight_t);
-    e->mean_takeoff_velocity_m_s = mean_or_nan(s->sum_v_m_s, s->n_v);
+    if (s->n_jump_h) e->mean_jump_m = s->sum_jump_m / (double)s->n_jump_h;
+    if (s->n_flight_t) e->mean_flight_s = s->sum_flight_s / (double)s->n_flight_t;
+    if (s->n_v) e->mean_takeoff_velocity_m_s = s->sum_v_m_s / (double)s->n_v;
 }
 
 void gs_session_close(gs_session *s)
