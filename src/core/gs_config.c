@@ -162,8 +162,8 @@ static gs_status fail(gs_cfg_error *err, gs_status st, uint32_t line, const char
                       const char *key, size_t keyn, const char *msg)
 {
     err->line = line;
-    copy_text(err->section, sizeof err->section, sec ? sec : "", sec ? secn : 0u);
-    copy_text(err->key, sizeof err->key, key ? key : "", key ? keyn : 0u);
+    copy_text(err->section, sizeof err->section, sec, secn); /* NULL only with length 0 */
+    copy_text(err->key, sizeof err->key, key, keyn);
     if (msg) copy_cstr(err->msg, sizeof err->msg, msg);
     return st;
 }
