@@ -182,7 +182,7 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
     const char *why = NULL; /* NULL: the handler's message */
     uint32_t line = 0;
     for (size_t pos = 0; pos < len && st == GS_OK;) {
-        size_t ls, le;
+        size_t ls, le, start = pos;
         pos = next_line(text, len, pos, &ls, &le);
         line++;
         key = NULL;
@@ -190,7 +190,7 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
         ln_tok t;
         lex_line(text + ls, le - ls, &t);
         st = GS_ESYNTAX;
-        if (memchr(text + ls, '\0', le - ls) || (le < len && text[le] == '\0')) {
+        if (memchr(text + start, '\0', pos - start)) { /* the line with its CR LF */
             why = "NUL byte in text";
         } else if (le - ls > CFG_MAX_LINE) {
             why = "line longer than 255 characters";
@@ -379,13 +379,13 @@ static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, siz
 
 /* the [core] keys that take a name, in the order of set_name and name_value */
 static const struct {
-    const char *key, *expected, *unknown;
+    const char *key, *expected;
     uint8_t max; /* the largest valid enum value */
 } k_name_keys[] = {
-    {"mass_table", "expected deleva, clauser or dempster", "unknown mass table", GS_MASS_DEMPSTER},
-    {"stature", "expected anthro or nose_ankle_1.17", "unknown stature method", GS_STATURE_NOSE_ANKLE_117},
-    {"fit", "expected irls, ransac or plain", "unknown fit method", GS_FIT_PLAIN},
-    {"format", "expected json or nmea", "unknown format", GS_FMT_NMEA},
+    {"mass_table", "expected deleva, clauser or dempster", GS_MASS_DEMPSTER},
+    {"stature", "expected anthro or nose_ankle_1.17", GS_STATURE_NOSE_ANKLE_117},
+    {"fit", "expected irls, ransac or plain", GS_FIT_PLAIN},
+    {"format", "expected json or nmea", GS_FMT_NMEA},
 };
 
 static bool set_name(gs_core_config *c, size_t i, const char *v, size_t n)
@@ -398,13 +398,15 @@ static bool set_name(gs_core_config *c, size_t i, const char *v, size_t n)
     }
 }
 
-static unsigned name_value(const gs_core_config *c, size_t i)
+/* The name key i's stored value and the check's message when it is out of range.
+ * Literals here, not in k_name_keys: a build without gs_core_config_check drops them. */
+static unsigned name_value(const gs_core_config *c, size_t i, const char **unknown)
 {
     switch (i) {
-    case 0: return (unsigned)c->mass_table;
-    case 1: return (unsigned)c->stature;
-    case 2: return (unsigned)c->fit_method;
-    default: return (unsigned)c->format;
+    case 0: *unknown = "unknown mass table"; return (unsigned)c->mass_table;
+    case 1: *unknown = "unknown stature method"; return (unsigned)c->stature;
+    case 2: *unknown = "unknown fit method"; return (unsigned)c->fit_method;
+    default: *unknown = "unknown format"; return (unsigned)c->format;
     }
 }
 
@@ -425,6 +427,15 @@ gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len, const c
     }
     copy_cstr(msg, cap, "unknown key");
     return GS_ENOKEY;
+}
+
+/* the name of the numeric key stored at this offset (the table's literal: the
+ * check's own copy would keep its strings in a build without the check) */
+static const char *key_at(size_t off)
+{
+    size_t i = 0;
+    while (i + 1u < sizeof k_num_keys / sizeof k_num_keys[0] && k_num_keys[i].off != off) i++;
+    return k_num_keys[i].key;
 }
 
 static gs_status check_fail(gs_cfg_error *err, gs_status st, const char *key, const char *msg)
@@ -468,12 +479,16 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
             return check_fail(err, GS_ERANGE, k->key, msg);
         }
     }
-    for (size_t i = 0; i < sizeof k_name_keys / sizeof k_name_keys[0]; i++)
-        if (name_value(c, i) > k_name_keys[i].max) return check_fail(err, GS_EINVAL, k_name_keys[i].key, k_name_keys[i].unknown);
+    for (size_t i = 0; i < sizeof k_name_keys / sizeof k_name_keys[0]; i++) {
+        const char *unknown;
+        if (name_value(c, i, &unknown) > k_name_keys[i].max) return check_fail(err, GS_EINVAL, k_name_keys[i].key, unknown);
+    }
     if (!(c->min_flight_s < c->max_flight_s))
-        return check_fail(err, GS_ERANGE, "max_flight_s", "max_flight_s must exceed min_flight_s");
+        return check_fail(err, GS_ERANGE, key_at(offsetof(gs_core_config, max_flight_s)),
+                          "max_flight_s must exceed min_flight_s");
     if (!(c->size_min_m < c->size_max_m))
-        return check_fail(err, GS_ERANGE, "size_max_m", "size_max_m must exceed size_min_m");
+        return check_fail(err, GS_ERANGE, key_at(offsetof(gs_core_config, size_max_m)),
+                          "size_max_m must exceed size_min_m");
     return GS_OK;
 }
 

@@ -152,6 +152,141 @@ static bool w_common(gs_w *w, const void *base, const field *f)
     return true;
 }
 
+/* ------------------------------------------------------------------ NMEA */
+
+/* NMEA text fields may not hold the delimiters $ * , ! \ ^ ~ or non-printables */
+static void n_text(gs_w *w, const char *s, size_t max_len)
+{
+    for (size_t i = 0; s && s[i] && i < max_len; i++) {
+        char c = s[i];
+        /* NMEA's reserved characters (not strchr: no libc search linked for this) */
+        if (c < 0x20 || c > 0x7e || c == '$' || c == '*' || c == ',' || c == '!' || c == '\\' || c == '^' ||
+            c == '~')
+            c = '_';
+        w_raw(w, &c, 1);
+    }
+}
+
+static const char k_hex_upper[] = "0123456789ABCDEF";
+
+/* after its comma */
+static void w_nmea_value(gs_w *w, const void *base, const field *f)
+{
+    if (w_common(w, base, f)) return;
+    const void *p = field_at(base, f);
+    char c[2];
+    size_t n = 0;
+    switch (f->kind) {
+    case V_FLAG: {
+        bool b;
+        memcpy(&b, p, sizeof b);
+        c[n++] = (char)(b ? f->a : f->b);
+        break;
+    }
+    case V_DIGIT: {
+        gs_reject_reason r;
+        memcpy(&r, p, sizeof r);
+        if ((uint32_t)r <= 9u) c[n++] = (char)('0' + (int)r);
+        break;
+    }
+    case V_INITIAL: { /* A absence, N new_body, E end_of_stream */
+        const char *s;
+        memcpy(&s, p, sizeof s);
+        if (s) c[n++] = (char)(s[0] >= 'a' && s[0] <= 'z' ? s[0] - 'a' + 'A' : '_');
+        break;
+    }
+    case V_HEX8: { /* the GS_WARN_* bits in hex */
+        uint32_t b;
+        memcpy(&b, p, sizeof b);
+        c[n++] = k_hex_upper[(b >> 4) & 15u];
+        c[n++] = k_hex_upper[b & 15u];
+        break;
+    }
+    default: { /* V_TEXT */
+        const char *s;
+        memcpy(&s, p, sizeof s);
+        n_text(w, s ? s : k_version, f->a);
+        break;
+    }
+    }
+    w_raw(w, c, n);
+}
+
+#define NF(type, name, kind, a, b) {(uint8_t)offsetof(type, name), kind, a, b}
+
+/* every sentence's fields, each after a comma, event by event (docs/protocol.md).
+ * Widths keep a sentence within 82 characters: $GSJMP 10+5+8+9+6+5+6+10+1+1 = 61
+ * = 82 - "$GSJMP" - 10 commas - "*HH\r\n"; $GSSES 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - 6 - 10 - 5. */
+static const field k_nmea_fields[] = {
+#define N_START 0
+    NF(gs_ev_start, version, V_TEXT, 20, 0),
+    NF(gs_ev_start, fps_source, V_FIXED, 3, 10),
+#define N_JUMP 2
+    NF(gs_ev_jump, t_takeoff_s, V_FIXED, 3, 10),
+    NF(gs_ev_jump, flight_time_s, V_FIXED, 3, 5),
+    NF(gs_ev_jump, a_px_s2, V_FIXED, 1, 8),
+    NF(gs_ev_jump, q_m_per_px, V_FIXED, 7, 9),
+    NF(gs_ev_jump, height_m, V_FIXED, 3, 6),
+    NF(gs_ev_jump, jump_height_m, V_FIXED, 3, 5),
+    NF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 2, 6),
+    NF(gs_ev_jump, n_samples, V_U32, 0, 0),
+    NF(gs_ev_jump, accepted, V_FLAG, 'A', 'R'),
+    NF(gs_ev_jump, reason, V_DIGIT, 0, 0),
+#define N_HEIGHT 12
+    NF(gs_ev_height, height_m, V_FIXED, 4, 12),
+    NF(gs_ev_height, ci95_lo_m, V_FIXED, 4, 12),
+    NF(gs_ev_height, ci95_hi_m, V_FIXED, 4, 12),
+    NF(gs_ev_height, n_jumps, V_U32, 0, 0),
+#define N_HEIGHT_END 16 /* the summary adds n_rejected */
+    NF(gs_ev_height, n_rejected, V_U32, 0, 0),
+#define N_SESSION 17
+    NF(gs_ev_session, session, V_U32, 0, 5),
+    NF(gs_ev_session, ended, V_FLAG, 'E', 'S'),
+    NF(gs_ev_session, reason, V_INITIAL, 0, 0),
+    NF(gs_ev_session, t_start_s, V_FIXED, 3, 10),
+    NF(gs_ev_session, t_end_s, V_FIXED, 3, 10),
+    NF(gs_ev_session, stature_m, V_FIXED, 3, 6),
+    NF(gs_ev_session, n_jumps, V_U32, 0, 3),
+    NF(gs_ev_session, best_jump_m, V_FIXED, 3, 5),
+    NF(gs_ev_session, mean_jump_m, V_FIXED, 3, 5),
+    NF(gs_ev_session, mean_flight_s, V_FIXED, 3, 5),
+#define N_WARNING 27
+    NF(gs_ev_warning, t_s, V_FIXED, 3, 10),
+    NF(gs_ev_warning, warnings, V_HEX8, 0, 0),
+#define N_END 29
+};
+_Static_assert(sizeof k_nmea_fields / sizeof k_nmea_fields[0] == N_END, "the N_* indexes match the table");
+
+/* a sentence: $GS, the tag, then fields [first, end); trace events have none */
+static const struct {
+    char tag[4];
+    uint8_t first, end;
+} k_nmea_lines[] = {
+    {"STA", N_START, N_JUMP},          {"JMP", N_JUMP, N_HEIGHT},     {"HGT", N_HEIGHT, N_HEIGHT_END},
+    {"SUM", N_HEIGHT, N_HEIGHT_END + 1}, {"SES", N_SESSION, N_WARNING}, {"WRN", N_WARNING, N_END},
+};
+
+size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
+{
+    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
+    if (w.ok && (unsigned)ev->type >= sizeof k_nmea_lines / sizeof k_nmea_lines[0]) w.ok = false;
+    if (!w.ok) return w_finish(&w);
+    w_raw(&w, "$GS", 3);
+    w_raw(&w, k_nmea_lines[ev->type].tag, 3);
+    for (unsigned i = k_nmea_lines[ev->type].first; i < k_nmea_lines[ev->type].end; i++) {
+        w_raw(&w, ",", 1);
+        w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
+    }
+    if (w.ok) {
+        unsigned char x = 0;
+        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
+        char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
+        w_raw(&w, tail, sizeof tail);
+        if (w.len > NMEA_MAX) w.ok = false; /* cannot happen with the widths above */
+    }
+    return w_finish(&w);
+}
+
 /* ------------------------------------------------------------------ JSON */
 
 /* a JSON string; NULL -> null. Control bytes become \u00XX; valid UTF-8 passes;
@@ -401,141 +536,6 @@ size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
         w_json_value(&w, &ev->u, &k_json_fields[i].f);
     }
     w_lit(&w, "}\n");
-    return w_finish(&w);
-}
-
-/* ------------------------------------------------------------------ NMEA */
-
-/* NMEA text fields may not hold the delimiters $ * , ! \ ^ ~ or non-printables */
-static void n_text(gs_w *w, const char *s, size_t max_len)
-{
-    for (size_t i = 0; s && s[i] && i < max_len; i++) {
-        char c = s[i];
-        /* NMEA's reserved characters (not strchr: no libc search linked for this) */
-        if (c < 0x20 || c > 0x7e || c == '$' || c == '*' || c == ',' || c == '!' || c == '\\' || c == '^' ||
-            c == '~')
-            c = '_';
-        w_raw(w, &c, 1);
-    }
-}
-
-static const char k_hex_upper[] = "0123456789ABCDEF";
-
-/* after its comma */
-static void w_nmea_value(gs_w *w, const void *base, const field *f)
-{
-    if (w_common(w, base, f)) return;
-    const void *p = field_at(base, f);
-    char c[2];
-    size_t n = 0;
-    switch (f->kind) {
-    case V_FLAG: {
-        bool b;
-        memcpy(&b, p, sizeof b);
-        c[n++] = (char)(b ? f->a : f->b);
-        break;
-    }
-    case V_DIGIT: {
-        gs_reject_reason r;
-        memcpy(&r, p, sizeof r);
-        if ((uint32_t)r <= 9u) c[n++] = (char)('0' + (int)r);
-        break;
-    }
-    case V_INITIAL: { /* A absence, N new_body, E end_of_stream */
-        const char *s;
-        memcpy(&s, p, sizeof s);
-        if (s) c[n++] = (char)(s[0] >= 'a' && s[0] <= 'z' ? s[0] - 'a' + 'A' : '_');
-        break;
-    }
-    case V_HEX8: { /* the GS_WARN_* bits in hex */
-        uint32_t b;
-        memcpy(&b, p, sizeof b);
-        c[n++] = k_hex_upper[(b >> 4) & 15u];
-        c[n++] = k_hex_upper[b & 15u];
-        break;
-    }
-    default: { /* V_TEXT */
-        const char *s;
-        memcpy(&s, p, sizeof s);
-        n_text(w, s ? s : k_version, f->a);
-        break;
-    }
-    }
-    w_raw(w, c, n);
-}
-
-#define NF(type, name, kind, a, b) {(uint8_t)offsetof(type, name), kind, a, b}
-
-/* every sentence's fields, each after a comma, event by event (docs/protocol.md).
- * Widths keep a sentence within 82 characters: $GSJMP 10+5+8+9+6+5+6+10+1+1 = 61
- * = 82 - "$GSJMP" - 10 commas - "*HH\r\n"; $GSSES 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - 6 - 10 - 5. */
-static const field k_nmea_fields[] = {
-#define N_START 0
-    NF(gs_ev_start, version, V_TEXT, 20, 0),
-    NF(gs_ev_start, fps_source, V_FIXED, 3, 10),
-#define N_JUMP 2
-    NF(gs_ev_jump, t_takeoff_s, V_FIXED, 3, 10),
-    NF(gs_ev_jump, flight_time_s, V_FIXED, 3, 5),
-    NF(gs_ev_jump, a_px_s2, V_FIXED, 1, 8),
-    NF(gs_ev_jump, q_m_per_px, V_FIXED, 7, 9),
-    NF(gs_ev_jump, height_m, V_FIXED, 3, 6),
-    NF(gs_ev_jump, jump_height_m, V_FIXED, 3, 5),
-    NF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 2, 6),
-    NF(gs_ev_jump, n_samples, V_U32, 0, 0),
-    NF(gs_ev_jump, accepted, V_FLAG, 'A', 'R'),
-    NF(gs_ev_jump, reason, V_DIGIT, 0, 0),
-#define N_HEIGHT 12
-    NF(gs_ev_height, height_m, V_FIXED, 4, 12),
-    NF(gs_ev_height, ci95_lo_m, V_FIXED, 4, 12),
-    NF(gs_ev_height, ci95_hi_m, V_FIXED, 4, 12),
-    NF(gs_ev_height, n_jumps, V_U32, 0, 0),
-#define N_HEIGHT_END 16 /* the summary adds n_rejected */
-    NF(gs_ev_height, n_rejected, V_U32, 0, 0),
-#define N_SESSION 17
-    NF(gs_ev_session, session, V_U32, 0, 5),
-    NF(gs_ev_session, ended, V_FLAG, 'E', 'S'),
-    NF(gs_ev_session, reason, V_INITIAL, 0, 0),
-    NF(gs_ev_session, t_start_s, V_FIXED, 3, 10),
-    NF(gs_ev_session, t_end_s, V_FIXED, 3, 10),
-    NF(gs_ev_session, stature_m, V_FIXED, 3, 6),
-    NF(gs_ev_session, n_jumps, V_U32, 0, 3),
-    NF(gs_ev_session, best_jump_m, V_FIXED, 3, 5),
-    NF(gs_ev_session, mean_jump_m, V_FIXED, 3, 5),
-    NF(gs_ev_session, mean_flight_s, V_FIXED, 3, 5),
-#define N_WARNING 27
-    NF(gs_ev_warning, t_s, V_FIXED, 3, 10),
-    NF(gs_ev_warning, warnings, V_HEX8, 0, 0),
-#define N_END 29
-};
-_Static_assert(sizeof k_nmea_fields / sizeof k_nmea_fields[0] == N_END, "the N_* indexes match the table");
-
-/* a sentence: $GS, the tag, then fields [first, end); trace events have none */
-static const struct {
-    char tag[4];
-    uint8_t first, end;
-} k_nmea_lines[] = {
-    {"STA", N_START, N_JUMP},          {"JMP", N_JUMP, N_HEIGHT},     {"HGT", N_HEIGHT, N_HEIGHT_END},
-    {"SUM", N_HEIGHT, N_HEIGHT_END + 1}, {"SES", N_SESSION, N_WARNING}, {"WRN", N_WARNING, N_END},
-};
-
-size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
-{
-    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
-    if (w.ok && (unsigned)ev->type >= sizeof k_nmea_lines / sizeof k_nmea_lines[0]) w.ok = false;
-    if (!w.ok) return w_finish(&w);
-    w_raw(&w, "$GS", 3);
-    w_raw(&w, k_nmea_lines[ev->type].tag, 3);
-    for (unsigned i = k_nmea_lines[ev->type].first; i < k_nmea_lines[ev->type].end; i++) {
-        w_raw(&w, ",", 1);
-        w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
-    }
-    if (w.ok) {
-        unsigned char x = 0;
-        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
-        char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
-        w_raw(&w, tail, sizeof tail);
-        if (w.len > NMEA_MAX) w.ok = false; /* cannot happen with the widths above */
-    }
     return w_finish(&w);
 }
 

@@ -8,16 +8,12 @@
 
 #define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
 
+/* the per-visit state: every field from gap_since_ref to the end (gs_session.h) */
 static void reset_visit(gs_session *s)
 {
-    s->gap_since_ref = false;
-    s->ref_n = 0;
+    memset(&s->gap_since_ref, 0, sizeof *s - offsetof(gs_session, gap_since_ref));
     s->ref_px = NAN;
-    s->odd_run = 0;
-    s->n_jumps = s->n_rejected = 0;
     s->best_jump_m = s->best_flight_s = NAN;
-    s->sum_jump_m = s->sum_flight_s = s->sum_v_m_s = 0.0;
-    s->n_jump_h = s->n_v = s->n_flight_t = 0;
 }
 
 void gs_session_init(gs_session *s, double absence_s, double new_body_rel)
