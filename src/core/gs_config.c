@@ -174,12 +174,15 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
     gs_cfg_error dummy;
     if (!err) err = &dummy;
     memset(err, 0, sizeof *err);
-    if (!text && len) return fail(err, GS_EINVAL, 0, NULL, 0, NULL, 0, "no text");
     const gs_cfg_section *cur = NULL;
     const char *cur_name = NULL, *key = NULL; /* where an error is: section and key */
     size_t cur_n = 0, key_n = 0;
     gs_status st = GS_OK;
     const char *why = NULL; /* NULL: the handler's message */
+    if (!text && len) {
+        st = GS_EINVAL;
+        why = "no text";
+    }
     uint32_t line = 0;
     for (size_t pos = 0; pos < len && st == GS_OK;) {
         size_t ls, le, start = pos;

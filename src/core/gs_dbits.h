@@ -22,7 +22,11 @@ static inline uint64_t gs_dbits(double x)
 /* the bits of |x|: for non-negative doubles, integer order is value order */
 static inline uint64_t gs_dbits_abs(double x) { return gs_dbits(x) & ~GS_DBITS_SIGN; }
 
-static inline bool gs_dfinite(double x) { return gs_dbits_abs(x) < GS_DBITS_INF; }
+/* the exponent field not all ones (a test of the high word only) */
+static inline bool gs_dfinite(double x)
+{
+    return ((uint32_t)(gs_dbits(x) >> 32) & 0x7FF00000u) != 0x7FF00000u;
+}
 
 static inline bool gs_disnan(double x) { return gs_dbits_abs(x) > GS_DBITS_INF; }
 
