@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "gravscale/gs_agg.h"
+#include "gs_dbits.h"
 
 /* With one flight the between-flight scatter cannot be seen; a per-flight
  * relative scatter (pose, size and outlier flights the fit's SE misses) is
@@ -24,31 +25,28 @@ static const gs_real k_mad_corr[10] = { 0, 0, 1.196, 1.495, 1.363, 1.206, 1.200,
  * is the mean; exact small-n ratios up to 5, the large-n value beyond. */
 static const gs_real k_median_se[6] = { 1.0, 1.0, 1.0, 1.160, 1.092, 1.197 };
 
-/* Student-t 97.5 % quantiles by degrees of freedom. */
-static const struct {
-    gs_real dof, q;
-} k_t975[] = {
-    { 1, 12.706 }, { 2, 4.303 }, { 3, 3.182 }, { 4, 2.776 }, { 5, 2.571 }, { 6, 2.447 },
-    { 7, 2.365 }, { 8, 2.306 }, { 9, 2.262 }, { 10, 2.228 }, { 12, 2.179 }, { 15, 2.131 },
-    { 20, 2.086 }, { 30, 2.042 }, { 40, 2.021 }, { 60, 2.000 }, { 120, 1.980 },
-};
-#define N_T975 (sizeof k_t975 / sizeof k_t975[0])
+/* Student-t 97.5 % quantiles by degrees of freedom (whole numbers: a byte each). */
+static const uint8_t k_t975_dof[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 15, 20, 30, 40, 60, 120};
+static const gs_real k_t975_q[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262,
+                                   2.228,  2.179, 2.131, 2.086, 2.042, 2.021, 2.000, 1.980};
+#define N_T975 (sizeof k_t975_dof / sizeof k_t975_dof[0])
+_Static_assert(sizeof k_t975_q / sizeof k_t975_q[0] == N_T975, "one quantile per dof");
 
 /* t quantile for a real dof >= 1, linear in 1/dof between table rows (exact
  * at the rows, 1.96 at infinity). */
 static gs_real t975(gs_real dof)
 {
     if (!(dof > GS_R(1.0))) {
-        return k_t975[0].q;
+        return k_t975_q[0];
     }
     for (size_t i = 1; i < N_T975; i++) {
-        if (dof <= k_t975[i].dof) {
-            gs_real a = GS_R(1.0) / k_t975[i - 1].dof, b = GS_R(1.0) / k_t975[i].dof, x = GS_R(1.0) / dof;
-            return k_t975[i - 1].q + (k_t975[i].q - k_t975[i - 1].q) * (a - x) / (a - b);
+        if (dof <= (gs_real)k_t975_dof[i]) {
+            gs_real a = GS_R(1.0) / (gs_real)k_t975_dof[i - 1], b = GS_R(1.0) / (gs_real)k_t975_dof[i], x = GS_R(1.0) / dof;
+            return k_t975_q[i - 1] + (k_t975_q[i] - k_t975_q[i - 1]) * (a - x) / (a - b);
         }
     }
-    gs_real b = GS_R(1.0) / k_t975[N_T975 - 1].dof;
-    return GS_R(1.96) + (k_t975[N_T975 - 1].q - GS_R(1.96)) * (GS_R(1.0) / dof) / b;
+    gs_real b = GS_R(1.0) / (gs_real)k_t975_dof[N_T975 - 1];
+    return GS_R(1.96) + (k_t975_q[N_T975 - 1] - GS_R(1.96)) * (GS_R(1.0) / dof) / b;
 }
 
 static void sort_asc(gs_real *v, uint32_t n)
@@ -88,12 +86,14 @@ void gs_agg_add(gs_agg *a, double value_m, double se_m)
         return;
     }
     /* A flight without a usable size was a flight that failed: count it as rejected. */
-    if (!isfinite(value_m) || !(value_m > 0.0)) {
+    if (!gs_dpositive(value_m)) {
         a->n_rejected++;
         return;
     }
     a->value[a->next] = (float)value_m;
-    a->se[a->next] = (isfinite(se_m) && se_m >= 0.0) ? (float)se_m : NAN; /* unknown SE kept as NaN */
+    /* finite and >= 0 (-0 included); an unknown SE is kept as NaN */
+    bool se_ok = gs_dbits(se_m) < GS_DBITS_INF || gs_dbits(se_m) == GS_DBITS_SIGN;
+    a->se[a->next] = se_ok ? (float)se_m : NAN;
     a->next = (a->next + 1u) % GS_AGG_MAX;
     if (a->held < GS_AGG_MAX) {
         a->held++;

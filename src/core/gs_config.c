@@ -8,6 +8,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "gs_dbits.h"
+
 #define CFG_MAX_LINE 255u
 
 /* ------------------------------------------------------------- utilities */
@@ -64,74 +66,64 @@ static void trim(const char **s, size_t *n)
     while (*n && is_blank((*s)[*n - 1u])) (*n)--;
 }
 
-/* One line without its line ending. */
-static ln_tok lex_line(const char *s, size_t n)
+/* One line without its line ending into *t (kind, names, LN_ERROR's reason). */
+static void lex_line(const char *s, size_t n, ln_tok *t)
 {
-    ln_tok t = {LN_EMPTY, NULL, 0, NULL, 0, NULL};
+    *t = (ln_tok){LN_EMPTY, NULL, 0, NULL, 0, NULL};
     trim(&s, &n);
-    if (n == 0 || s[0] == '#' || s[0] == ';') return t;
+    if (n == 0 || s[0] == '#' || s[0] == ';') return;
+    t->kind = LN_ERROR;
     if (s[0] == '[') {
         size_t rb = 1;
         while (rb < n && s[rb] != ']') rb++;
         if (rb == n) {
-            t.kind = LN_ERROR;
-            t.err = "section header without ']'";
-            return t;
+            t->err = "section header without ']'";
+            return;
         }
         /* after ']' only blanks or a comment */
-        for (size_t i = rb + 1u; i < n; i++) {
-            if (s[i] == '#' || s[i] == ';') break;
+        for (size_t i = rb + 1u; i < n && s[i] != '#' && s[i] != ';'; i++) {
             if (!is_blank(s[i])) {
-                t.kind = LN_ERROR;
-                t.err = "text after section header";
-                return t;
+                t->err = "text after section header";
+                return;
             }
         }
-        t.a = s + 1;
-        t.an = rb - 1u;
-        trim(&t.a, &t.an);
-        if (t.an == 0) {
-            t.kind = LN_ERROR;
-            t.err = "empty section name";
-            return t;
-        }
-        t.kind = LN_SECTION;
-        return t;
+        t->a = s + 1;
+        t->an = rb - 1u;
+        trim(&t->a, &t->an);
+        if (t->an == 0) t->err = "empty section name";
+        else t->kind = LN_SECTION;
+        return;
     }
     size_t eq = 0;
     while (eq < n && s[eq] != '=') eq++;
     if (eq == n) {
-        t.kind = LN_ERROR;
-        t.err = "expected 'key = value'";
-        return t;
+        t->err = "expected 'key = value'";
+        return;
     }
-    t.a = s;
-    t.an = eq;
-    trim(&t.a, &t.an);
-    t.kind = LN_KEY;
-    if (t.an == 0) {
-        t.kind = LN_ERROR;
-        t.err = "empty key";
-        return t;
+    t->a = s;
+    t->an = eq;
+    trim(&t->a, &t->an);
+    if (t->an == 0) {
+        t->err = "empty key";
+        return;
     }
-    for (size_t i = 0; i < t.an; i++) {
-        if (!key_char_ok(t.a[i])) {
-            t.kind = LN_ERROR;
-            t.err = "bad character in key";
-            return t;
+    for (size_t i = 0; i < t->an; i++) {
+        if (!key_char_ok(t->a[i])) {
+            t->err = "bad character in key";
+            return;
         }
     }
-    t.b = s + eq + 1u;
-    t.bn = n - eq - 1u;
+    t->kind = LN_KEY;
+    t->b = s + eq + 1u;
+    t->bn = n - eq - 1u;
     /* an inline comment starts at # or ; preceded by a blank */
-    for (size_t i = 1; i < t.bn; i++) {
-        if ((t.b[i] == '#' || t.b[i] == ';') && is_blank(t.b[i - 1u])) {
-            t.bn = i;
+    for (size_t i = 1; i < t->bn; i++) {
+        if ((t->b[i] == '#' || t->b[i] == ';') && is_blank(t->b[i - 1u])) {
+            t->bn = i;
             break;
         }
     }
-    trim(&t.b, &t.bn);
-    return t;
+    trim(&t->b, &t->bn);
 }
 
 /* next line of text[pos..len): [*ls, *le) without CR/LF; returns the next pos */
@@ -154,7 +146,8 @@ static bool seen_before(const char *text, size_t upto, const char *sec, size_t s
     while (pos < upto) {
         size_t ls, le;
         pos = next_line(text, upto, pos, &ls, &le);
-        ln_tok t = lex_line(text + ls, le - ls);
+        ln_tok t;
+        lex_line(text + ls, le - ls, &t);
         if (t.kind == LN_SECTION) {
             cur = t.a;
             curn = t.an;
@@ -169,8 +162,8 @@ static gs_status fail(gs_cfg_error *err, gs_status st, uint32_t line, const char
                       const char *key, size_t keyn, const char *msg)
 {
     err->line = line;
-    copy_text(err->section, sizeof err->section, sec ? sec : "", sec ? secn : 0u);
-    copy_text(err->key, sizeof err->key, key ? key : "", key ? keyn : 0u);
+    copy_text(err->section, sizeof err->section, sec, secn); /* NULL only with length 0 */
+    copy_text(err->key, sizeof err->key, key, keyn);
     if (msg) copy_cstr(err->msg, sizeof err->msg, msg);
     return st;
 }
@@ -181,23 +174,32 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
     gs_cfg_error dummy;
     if (!err) err = &dummy;
     memset(err, 0, sizeof *err);
-    if (!text && len) return fail(err, GS_EINVAL, 0, NULL, 0, NULL, 0, "no text");
     const gs_cfg_section *cur = NULL;
-    const char *cur_name = NULL;
-    size_t cur_n = 0;
+    const char *cur_name = NULL, *key = NULL; /* where an error is: section and key */
+    size_t cur_n = 0, key_n = 0;
+    gs_status st = GS_OK;
+    const char *why = NULL; /* NULL: the handler's message */
+    if (!text && len) {
+        st = GS_EINVAL;
+        why = "no text";
+    }
     uint32_t line = 0;
-    size_t pos = 0;
-    while (pos < len) {
-        size_t ls, le;
-        size_t next = next_line(text, len, pos, &ls, &le);
+    for (size_t pos = 0; pos < len && st == GS_OK;) {
+        size_t ls, le, start = pos;
+        pos = next_line(text, len, pos, &ls, &le);
         line++;
-        if (memchr(text + ls, '\0', le - ls) || (le < len && text[le] == '\0'))
-            return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, "NUL byte in text");
-        if (le - ls > CFG_MAX_LINE)
-            return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, "line longer than 255 characters");
-        ln_tok t = lex_line(text + ls, le - ls);
-        if (t.kind == LN_ERROR) return fail(err, GS_ESYNTAX, line, cur_name, cur_n, NULL, 0, t.err);
-        if (t.kind == LN_SECTION) {
+        key = NULL;
+        key_n = 0;
+        ln_tok t;
+        lex_line(text + ls, le - ls, &t);
+        st = GS_ESYNTAX;
+        if (memchr(text + start, '\0', pos - start)) { /* the line with its CR LF */
+            why = "NUL byte in text";
+        } else if (le - ls > CFG_MAX_LINE) {
+            why = "line longer than 255 characters";
+        } else if (t.kind == LN_ERROR) {
+            why = t.err;
+        } else if (t.kind == LN_SECTION) {
             cur = NULL;
             for (size_t i = 0; sections && i < n_sections; i++) {
                 if (sections[i].name && is_lit(t.a, t.an, sections[i].name)) {
@@ -205,26 +207,31 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
                     break;
                 }
             }
-            if (!cur) return fail(err, GS_ENOKEY, line, t.a, t.an, NULL, 0, "unknown section");
             cur_name = t.a;
             cur_n = t.an;
+            st = cur ? GS_OK : GS_ENOKEY;
+            why = "unknown section";
         } else if (t.kind == LN_KEY) {
-            if (!cur) return fail(err, GS_ESYNTAX, line, NULL, 0, t.a, t.an, "key before any [section]");
-            if (seen_before(text, ls, cur_name, cur_n, t.a, t.an))
-                return fail(err, GS_EINVAL, line, cur_name, cur_n, t.a, t.an, "duplicate key");
-            err->msg[0] = '\0';
-            gs_status st = cur->fn ? cur->fn(cur->ctx, t.a, t.an, t.b, t.bn, err->msg, sizeof err->msg)
-                                   : GS_ENOKEY;
-            if (st != GS_OK) {
-                const char *why = err->msg[0] ? NULL
-                                  : st == GS_ENOKEY ? "unknown key"
-                                  : st == GS_ERANGE ? "value out of range"
-                                                    : "bad value";
-                return fail(err, st, line, cur_name, cur_n, t.a, t.an, why);
+            key = t.a;
+            key_n = t.an;
+            if (!cur) {
+                why = "key before any [section]";
+            } else if (seen_before(text, ls, cur_name, cur_n, t.a, t.an)) {
+                st = GS_EINVAL;
+                why = "duplicate key";
+            } else {
+                err->msg[0] = '\0';
+                st = cur->fn ? cur->fn(cur->ctx, t.a, t.an, t.b, t.bn, err->msg, sizeof err->msg) : GS_ENOKEY;
+                why = err->msg[0] ? NULL
+                      : st == GS_ENOKEY ? "unknown key"
+                      : st == GS_ERANGE ? "value out of range"
+                                        : "bad value";
             }
+        } else {
+            st = GS_OK;
         }
-        pos = next;
     }
+    if (st != GS_OK) return fail(err, st, line, cur_name, cur_n, key, key_n, why);
     err->msg[0] = '\0'; /* a handler may have left text on success */
     return GS_OK;
 }
@@ -233,87 +240,122 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
 
 typedef enum { T_DBL, T_DBL_AUTO, T_FLT, T_U32, T_U32_POW2 } num_type;
 
+/* A numeric key: its range in thousandths (milli / 1000.0, one correctly rounded
+ * division, is the double nearest the decimal bound, as the literal would be:
+ * 8 bytes a key instead of two doubles) and where it is stored. */
 typedef struct {
     const char *key;
-    num_type type;
-    double lo, hi;
-    size_t off;
+    int32_t lo_milli, hi_milli;
+    uint8_t type; /* num_type; from T_U32 on an integer */
+    uint8_t off;  /* offsetof in gs_core_config */
 } num_key;
+
+#define MILLI(x) ((int32_t)((x) * 1000 + ((x) < 0 ? -0.5 : 0.5)))
+#define NK(name, type, lo, hi) {#name, MILLI(lo), MILLI(hi), type, offsetof(gs_core_config, name)}
+_Static_assert(sizeof(gs_core_config) <= 256, "num_key.off is 8 bits");
 
 /* every numeric [core] key with its range (docs/config.md lists the same) */
 static const num_key k_num_keys[] = {
-    {"g_m_s2", T_DBL_AUTO, 9.7, 9.9, offsetof(gs_core_config, g_m_s2)},
-    {"latitude_deg", T_DBL_AUTO, -90.0, 90.0, offsetof(gs_core_config, latitude_deg)},
-    {"altitude_m", T_DBL, -500.0, 9000.0, offsetof(gs_core_config, altitude_m)},
-    {"min_conf", T_FLT, 0.0, 1.0, offsetof(gs_core_config, min_conf)},
-    {"ring_capacity", T_U32_POW2, 64.0, 65536.0, offsetof(gs_core_config, ring_capacity)},
-    {"min_flight_s", T_FLT, 0.05, 2.0, offsetof(gs_core_config, min_flight_s)},
-    {"max_flight_s", T_FLT, 0.1, 5.0, offsetof(gs_core_config, max_flight_s)},
-    {"min_samples", T_U32, 4.0, 1000.0, offsetof(gs_core_config, min_samples)},
-    {"max_rms_rel", T_FLT, 0.001, 1.0, offsetof(gs_core_config, max_rms_rel)},
-    {"max_a_se_rel", T_FLT, 0.001, 1.0, offsetof(gs_core_config, max_a_se_rel)},
-    {"size_min_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_min_m)},
-    {"size_max_m", T_FLT, 0.0, 10.0, offsetof(gs_core_config, size_max_m)},
-    {"max_gap_s", T_FLT, 0.01, 2.0, offsetof(gs_core_config, max_gap_s)},
-    {"landing_latency_s", T_FLT, 0.02, 1.0, offsetof(gs_core_config, landing_latency_s)},
-    {"session_absence_s", T_FLT, 0.5, 600.0, offsetof(gs_core_config, session_absence_s)},
-    {"session_new_body_rel", T_FLT, 0.03, 0.5, offsetof(gs_core_config, session_new_body_rel)},
+    NK(g_m_s2, T_DBL_AUTO, 9.7, 9.9),
+    NK(latitude_deg, T_DBL_AUTO, -90, 90),
+    NK(altitude_m, T_DBL, -500, 9000),
+    NK(min_conf, T_FLT, 0, 1),
+    NK(ring_capacity, T_U32_POW2, 64, 65536),
+    NK(min_flight_s, T_FLT, 0.05, 2),
+    NK(max_flight_s, T_FLT, 0.1, 5),
+    NK(min_samples, T_U32, 4, 1000),
+    NK(max_rms_rel, T_FLT, 0.001, 1),
+    NK(max_a_se_rel, T_FLT, 0.001, 1),
+    NK(size_min_m, T_FLT, 0, 10),
+    NK(size_max_m, T_FLT, 0, 10),
+    NK(max_gap_s, T_FLT, 0.01, 2),
+    NK(landing_latency_s, T_FLT, 0.02, 1),
+    NK(session_absence_s, T_FLT, 0.5, 600),
+    NK(session_new_body_rel, T_FLT, 0.03, 0.5),
 };
 
 void gs_core_config_default(gs_core_config *c)
 {
-    if (!c) return;
-    memset(c, 0, sizeof *c);
-    c->g_m_s2 = NAN;
-    c->latitude_deg = NAN;
-    c->altitude_m = 0.0;
-    c->mass_table = GS_MASS_DELEVA;
-    c->stature = GS_STATURE_ANTHRO;
-    c->min_conf = 0.1f;  /* blurred fast limbs come with low confidence but usable positions */
-    c->fit_method = GS_FIT_IRLS;
-    c->ring_capacity = 512u;
-    c->min_flight_s = 0.12f;
-    c->max_flight_s = 1.5f;
-    c->min_samples = 6u;
-    c->max_rms_rel = 0.03f;
-    c->max_a_se_rel = 0.15f;
-    c->size_min_m = 0.3f;
-    c->size_max_m = 2.6f;
-    c->max_gap_s = 0.2f;
-    c->landing_latency_s = 0.2f;
-    c->session_absence_s = 2.5f;
-    c->session_new_body_rel = 0.12f;
-    c->format = GS_WITH_JSON ? GS_FMT_JSON : GS_FMT_NMEA; /* the one built in (gs_features.h) */
+    static const gs_core_config k_default = {
+        .g_m_s2 = NAN,
+        .latitude_deg = NAN,
+        .altitude_m = 0.0,
+        .mass_table = GS_MASS_DELEVA,
+        .stature = GS_STATURE_ANTHRO,
+        .min_conf = 0.1f, /* blurred fast limbs come with low confidence but usable positions */
+        .fit_method = GS_FIT_IRLS,
+        .ring_capacity = 512u,
+        .min_flight_s = 0.12f,
+        .max_flight_s = 1.5f,
+        .min_samples = 6u,
+        .max_rms_rel = 0.03f,
+        .max_a_se_rel = 0.15f,
+        .size_min_m = 0.3f,
+        .size_max_m = 2.6f,
+        .max_gap_s = 0.2f,
+        .landing_latency_s = 0.2f,
+        .session_absence_s = 2.5f,
+        .session_new_body_rel = 0.12f,
+        .format = GS_WITH_JSON ? GS_FMT_JSON : GS_FMT_NMEA, /* the one built in (gs_features.h) */
+    };
+    if (c) *c = k_default;
+}
+
+static double bound(int32_t milli) { return (double)milli / 1000.0; }
+
+/* a bound as gs_num_fmt_sig(.., 6) writes it: at most 3 decimals, trailing zeros cut */
+static void append_bound(char *msg, size_t cap, int32_t milli)
+{
+    char t[32];
+    size_t n = gs_num_fmt_fixed(t, sizeof t, bound(milli), 3);
+    while (t[n - 1u] == '0') n--;
+    if (t[n - 1u] == '.') n--;
+    t[n] = '\0';
+    append(msg, cap, t);
 }
 
 static void range_msg(char *msg, size_t cap, const num_key *k)
 {
-    char lo[32], hi[32];
-    gs_num_fmt_sig(lo, sizeof lo, k->lo, 6);
-    gs_num_fmt_sig(hi, sizeof hi, k->hi, 6);
     copy_cstr(msg, cap, k->type == T_U32_POW2 ? "must be a power of two in " : "must be within ");
-    append(msg, cap, lo);
+    append_bound(msg, cap, k->lo_milli);
     append(msg, cap, "..");
-    append(msg, cap, hi);
+    append_bound(msg, cap, k->hi_milli);
 }
 
 static bool is_pow2(uint32_t v) { return v && !(v & (v - 1u)); }
 
+/* an integer key's value within its (whole-number) range */
+static bool int_ok(const num_key *k, int64_t x)
+{
+    return x >= k->lo_milli / 1000 && x <= k->hi_milli / 1000 && (k->type != T_U32_POW2 || is_pow2((uint32_t)x));
+}
+
+/* lo <= x <= hi; a float field holds the decimal bounds only as floats */
+static bool dbl_ok(const num_key *k, double x, bool as_float)
+{
+    double lo = bound(k->lo_milli), hi = bound(k->hi_milli);
+    if (as_float) {
+        lo = (double)(float)lo;
+        hi = (double)(float)hi;
+    }
+    return x >= lo && x <= hi;
+}
+
 static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, size_t n, char *msg, size_t cap)
 {
-    unsigned char *base = (unsigned char *)c;
-    if (k->type == T_U32 || k->type == T_U32_POW2) {
+    unsigned char *field = (unsigned char *)c + k->off;
+    if (k->type >= T_U32) {
         long x;
         if (!gs_num_parse_int(v, n, &x)) {
             copy_cstr(msg, cap, "not an integer");
             return GS_EINVAL;
         }
-        if ((double)x < k->lo || (double)x > k->hi || (k->type == T_U32_POW2 && !is_pow2((uint32_t)x))) {
+        if (!int_ok(k, x)) {
             range_msg(msg, cap, k);
             return GS_ERANGE;
         }
         uint32_t u = (uint32_t)x;
-        memcpy(base + k->off, &u, sizeof u);
+        memcpy(field, &u, sizeof u);
         return GS_OK;
     }
     double x;
@@ -324,18 +366,51 @@ static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, siz
             copy_cstr(msg, cap, k->type == T_DBL_AUTO ? "not a number (or auto)" : "not a number");
             return GS_EINVAL;
         }
-        if (!(x >= k->lo && x <= k->hi)) {
+        if (!dbl_ok(k, x, false)) {
             range_msg(msg, cap, k);
             return GS_ERANGE;
         }
     }
     if (k->type == T_FLT) {
         float f = (float)x;
-        memcpy(base + k->off, &f, sizeof f);
+        memcpy(field, &f, sizeof f);
     } else {
-        memcpy(base + k->off, &x, sizeof x);
+        memcpy(field, &x, sizeof x);
     }
     return GS_OK;
+}
+
+/* the [core] keys that take a name, in the order of set_name and name_value */
+static const struct {
+    const char *key, *expected;
+    uint8_t max; /* the largest valid enum value */
+} k_name_keys[] = {
+    {"mass_table", "expected deleva, clauser or dempster", GS_MASS_DEMPSTER},
+    {"stature", "expected anthro or nose_ankle_1.17", GS_STATURE_NOSE_ANKLE_117},
+    {"fit", "expected irls, ransac or plain", GS_FIT_PLAIN},
+    {"format", "expected json or nmea", GS_FMT_NMEA},
+};
+
+static bool set_name(gs_core_config *c, size_t i, const char *v, size_t n)
+{
+    switch (i) {
+    case 0: return gs_mass_table_from_name(v, n, &c->mass_table);
+    case 1: return gs_stature_method_from_name(v, n, &c->stature);
+    case 2: return gs_fit_method_from_name(v, n, &c->fit_method);
+    default: return gs_format_from_name(v, n, &c->format);
+    }
+}
+
+/* The name key i's stored value and the check's message when it is out of range.
+ * Literals here, not in k_name_keys: a build without gs_core_config_check drops them. */
+static unsigned name_value(const gs_core_config *c, size_t i, const char **unknown)
+{
+    switch (i) {
+    case 0: *unknown = "unknown mass table"; return (unsigned)c->mass_table;
+    case 1: *unknown = "unknown stature method"; return (unsigned)c->stature;
+    case 2: *unknown = "unknown fit method"; return (unsigned)c->fit_method;
+    default: *unknown = "unknown format"; return (unsigned)c->format;
+    }
 }
 
 gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len, const char *value, size_t value_len,
@@ -347,28 +422,23 @@ gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len, const c
     trim(&value, &value_len);
     for (size_t i = 0; i < sizeof k_num_keys / sizeof k_num_keys[0]; i++)
         if (is_lit(key, key_len, k_num_keys[i].key)) return set_num(c, &k_num_keys[i], value, value_len, msg, cap);
-    if (is_lit(key, key_len, "mass_table")) {
-        if (gs_mass_table_from_name(value, value_len, &c->mass_table)) return GS_OK;
-        copy_cstr(msg, cap, "expected deleva, clauser or dempster");
-        return GS_EINVAL;
-    }
-    if (is_lit(key, key_len, "stature")) {
-        if (gs_stature_method_from_name(value, value_len, &c->stature)) return GS_OK;
-        copy_cstr(msg, cap, "expected anthro or nose_ankle_1.17");
-        return GS_EINVAL;
-    }
-    if (is_lit(key, key_len, "fit")) {
-        if (gs_fit_method_from_name(value, value_len, &c->fit_method)) return GS_OK;
-        copy_cstr(msg, cap, "expected irls, ransac or plain");
-        return GS_EINVAL;
-    }
-    if (is_lit(key, key_len, "format")) {
-        if (gs_format_from_name(value, value_len, &c->format)) return GS_OK;
-        copy_cstr(msg, cap, "expected json or nmea");
+    for (size_t i = 0; i < sizeof k_name_keys / sizeof k_name_keys[0]; i++) {
+        if (!is_lit(key, key_len, k_name_keys[i].key)) continue;
+        if (set_name(c, i, value, value_len)) return GS_OK;
+        copy_cstr(msg, cap, k_name_keys[i].expected);
         return GS_EINVAL;
     }
     copy_cstr(msg, cap, "unknown key");
     return GS_ENOKEY;
+}
+
+/* the name of the numeric key stored at this offset (the table's literal: the
+ * check's own copy would keep its strings in a build without the check) */
+static const char *key_at(size_t off)
+{
+    size_t i = 0;
+    while (i + 1u < sizeof k_num_keys / sizeof k_num_keys[0] && k_num_keys[i].off != off) i++;
+    return k_num_keys[i].key;
 }
 
 static gs_status check_fail(gs_cfg_error *err, gs_status st, const char *key, const char *msg)
@@ -387,25 +457,24 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
     if (err) memset(err, 0, sizeof *err);
     if (!c) return check_fail(err, GS_EINVAL, "", "no config");
     /* a config filled in by code gets the same range checks as a parsed one */
-    const unsigned char *base = (const unsigned char *)c;
     for (size_t i = 0; i < sizeof k_num_keys / sizeof k_num_keys[0]; i++) {
         const num_key *k = &k_num_keys[i];
-        double x;
+        const unsigned char *field = (const unsigned char *)c + k->off;
         bool ok;
-        if (k->type == T_U32 || k->type == T_U32_POW2) {
+        if (k->type >= T_U32) {
             uint32_t u;
-            memcpy(&u, base + k->off, sizeof u);
-            x = (double)u;
-            ok = x >= k->lo && x <= k->hi && (k->type != T_U32_POW2 || is_pow2(u));
-        } else if (k->type == T_FLT) {
-            float f;
-            memcpy(&f, base + k->off, sizeof f);
-            x = (double)f;
-            /* a float holds the decimal bound only approximately */
-            ok = x >= (double)(float)k->lo && x <= (double)(float)k->hi;
+            memcpy(&u, field, sizeof u);
+            ok = int_ok(k, u);
         } else {
-            memcpy(&x, base + k->off, sizeof x);
-            ok = (k->type == T_DBL_AUTO && isnan(x)) || (x >= k->lo && x <= k->hi);
+            double x;
+            if (k->type == T_FLT) {
+                float f;
+                memcpy(&f, field, sizeof f);
+                x = (double)f;
+            } else {
+                memcpy(&x, field, sizeof x);
+            }
+            ok = (k->type == T_DBL_AUTO && gs_disnan(x)) || dbl_ok(k, x, k->type == T_FLT);
         }
         if (!ok) {
             char msg[64];
@@ -413,17 +482,16 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
             return check_fail(err, GS_ERANGE, k->key, msg);
         }
     }
-    if ((unsigned)c->mass_table > (unsigned)GS_MASS_DEMPSTER)
-        return check_fail(err, GS_EINVAL, "mass_table", "unknown mass table");
-    if ((unsigned)c->stature > (unsigned)GS_STATURE_NOSE_ANKLE_117)
-        return check_fail(err, GS_EINVAL, "stature", "unknown stature method");
-    if ((unsigned)c->fit_method > (unsigned)GS_FIT_PLAIN)
-        return check_fail(err, GS_EINVAL, "fit", "unknown fit method");
-    if ((unsigned)c->format > (unsigned)GS_FMT_NMEA) return check_fail(err, GS_EINVAL, "format", "unknown format");
+    for (size_t i = 0; i < sizeof k_name_keys / sizeof k_name_keys[0]; i++) {
+        const char *unknown;
+        if (name_value(c, i, &unknown) > k_name_keys[i].max) return check_fail(err, GS_EINVAL, k_name_keys[i].key, unknown);
+    }
     if (!(c->min_flight_s < c->max_flight_s))
-        return check_fail(err, GS_ERANGE, "max_flight_s", "max_flight_s must exceed min_flight_s");
+        return check_fail(err, GS_ERANGE, key_at(offsetof(gs_core_config, max_flight_s)),
+                          "max_flight_s must exceed min_flight_s");
     if (!(c->size_min_m < c->size_max_m))
-        return check_fail(err, GS_ERANGE, "size_max_m", "size_max_m must exceed size_min_m");
+        return check_fail(err, GS_ERANGE, key_at(offsetof(gs_core_config, size_max_m)),
+                          "size_max_m must exceed size_min_m");
     return GS_OK;
 }
 
@@ -441,7 +509,8 @@ double gs_gravity_m_s2(double latitude_deg, double altitude_m)
 double gs_core_config_g(const gs_core_config *c)
 {
     if (!c) return 9.81;
-    if (isfinite(c->g_m_s2)) return c->g_m_s2;
-    if (isfinite(c->latitude_deg)) return gs_gravity_m_s2(c->latitude_deg, isfinite(c->altitude_m) ? c->altitude_m : 0.0);
+    if (gs_dfinite(c->g_m_s2)) return c->g_m_s2;
+    if (gs_dfinite(c->latitude_deg))
+        return gs_gravity_m_s2(c->latitude_deg, gs_dfinite(c->altitude_m) ? c->altitude_m : 0.0);
     return 9.81;
 }

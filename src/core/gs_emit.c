@@ -4,11 +4,17 @@
 #include "gravscale/gs_emit.h"
 #include "gravscale/gs_num.h"
 
-#include <math.h>
 #include <string.h>
+
+#include "gs_dbits.h"
 
 /* NMEA 0183 caps a sentence at 82 characters including "$" and CR LF. */
 #define NMEA_MAX 82u
+
+/* the default version text of both start lines: one object of its own, so that a
+ * build with one format does not keep the other format's literals, which the
+ * compiler groups with the first function that uses a shared literal */
+static const char k_version[] = GS_VERSION;
 
 typedef struct {
     char *buf;
@@ -38,17 +44,6 @@ static void w_lit(gs_w *w, const char *s)
     }
 }
 
-static void w_u32(gs_w *w, uint32_t v)
-{
-    char t[12];
-    size_t n = sizeof t;
-    do {
-        t[--n] = (char)('0' + v % 10u);
-        v /= 10u;
-    } while (v);
-    w_raw(w, t + n, sizeof t - n);
-}
-
 /* Length of the valid UTF-8 sequence at s (RFC 3629: no overlong forms, no
  * surrogates, at most U+10FFFF), 0 when invalid. s is NUL-terminated and a NUL
  * fails the continuation test, so nothing past the string is read. */
@@ -69,6 +64,230 @@ static size_t utf8_len(const unsigned char *s)
     if (cp < min || cp > 0x10FFFFu || (cp >= 0xD800u && cp <= 0xDFFFu)) return 0;
     return n;
 }
+
+static size_t w_finish(gs_w *w)
+{
+    if (!w->ok) {
+        if (w->buf && w->cap) w->buf[0] = '\0';
+        return 0;
+    }
+    w->buf[w->len] = '\0';
+    return w->len;
+}
+
+/* v in decimal; width > 0: nothing when it needs more characters (NMEA fields) */
+static void w_u32(gs_w *w, uint32_t v, size_t width)
+{
+    char t[12];
+    size_t n = sizeof t;
+    do {
+        t[--n] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v);
+    if (!width || sizeof t - n <= width) w_raw(w, t + n, sizeof t - n);
+}
+
+/* v with `decimals` decimals. width 0 (JSON): null when v is not finite or beyond
+ * 1e15. width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the
+ * text is wider, nothing when v is unknown or cannot fit. */
+static void w_fixed(gs_w *w, double v, int decimals, size_t width)
+{
+    char t[40];
+    for (int d = decimals; d >= 0; d--) {
+        size_t n = gs_num_fmt_fixed(t, sizeof t, v, d);
+        if (n && (!width || n <= width)) {
+            w_raw(w, t, n);
+            return;
+        }
+        if (!width) break;
+    }
+    if (!width) w_lit(w, "null");
+}
+
+/* ------------------------------------------------ fields from a table */
+
+/* What a field's bytes at its offset are and how they are written. The first
+ * kinds serve both formats; then JSON's, then NMEA's. */
+enum {
+    V_U32,      /* uint32_t; b = NMEA width */
+    V_FIXED,    /* double, a decimals; b = NMEA width */
+    V_SIG,      /* JSON: double, a significant digits */
+    V_FLOAT,    /* JSON: float, a decimals */
+    V_STR,      /* JSON: const char * string or null; a = 1: NULL is this build's version */
+    V_BOOL,     /* JSON: bool as the pair k_json_bool[a] (true, false) */
+    V_REASON,   /* JSON: a jump's reject reason, null when accepted */
+    V_WARNINGS, /* JSON: uint32_t GS_WARN_* bits as an array of names */
+    V_CI95,     /* JSON: the doubles mid, lo, hi from here as [lo,hi] or null */
+    V_FLAG,     /* NMEA: bool as the character a (true) or b (false) */
+    V_DIGIT,    /* NMEA: a gs_reject_reason as one digit */
+    V_INITIAL,  /* NMEA: a string's first letter in upper case */
+    V_HEX8,     /* NMEA: the low byte of a uint32_t in two hex digits */
+    V_TEXT      /* NMEA: a string of at most a characters, NULL: this build's version */
+};
+
+typedef struct {
+    uint8_t off; /* offsetof the field in the event's union member */
+    uint8_t kind, a, b;
+} field;
+
+_Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field.off is 8 bits");
+
+static const void *field_at(const void *base, const field *f) { return (const char *)base + f->off; }
+
+/* the kinds both formats use; false for the others */
+static bool w_common(gs_w *w, const void *base, const field *f)
+{
+    const void *p = field_at(base, f);
+    if (f->kind == V_U32) {
+        uint32_t v;
+        memcpy(&v, p, sizeof v);
+        w_u32(w, v, f->b);
+    } else if (f->kind == V_FIXED) {
+        double v;
+        memcpy(&v, p, sizeof v);
+        w_fixed(w, v, f->a, f->b);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+/* ------------------------------------------------------------------ NMEA */
+
+/* NMEA text fields may not hold the delimiters $ * , ! \ ^ ~ or non-printables */
+static void n_text(gs_w *w, const char *s, size_t max_len)
+{
+    for (size_t i = 0; s && s[i] && i < max_len; i++) {
+        char c = s[i];
+        /* NMEA's reserved characters (not strchr: no libc search linked for this) */
+        if (c < 0x20 || c > 0x7e || c == '$' || c == '*' || c == ',' || c == '!' || c == '\\' || c == '^' ||
+            c == '~')
+            c = '_';
+        w_raw(w, &c, 1);
+    }
+}
+
+static const char k_hex_upper[] = "0123456789ABCDEF";
+
+/* after its comma */
+static void w_nmea_value(gs_w *w, const void *base, const field *f)
+{
+    if (w_common(w, base, f)) return;
+    const void *p = field_at(base, f);
+    char c[2];
+    size_t n = 0;
+    switch (f->kind) {
+    case V_FLAG: {
+        bool b;
+        memcpy(&b, p, sizeof b);
+        c[n++] = (char)(b ? f->a : f->b);
+        break;
+    }
+    case V_DIGIT: {
+        gs_reject_reason r;
+        memcpy(&r, p, sizeof r);
+        if ((uint32_t)r <= 9u) c[n++] = (char)('0' + (int)r);
+        break;
+    }
+    case V_INITIAL: { /* A absence, N new_body, E end_of_stream */
+        const char *s;
+        memcpy(&s, p, sizeof s);
+        if (s) c[n++] = (char)(s[0] >= 'a' && s[0] <= 'z' ? s[0] - 'a' + 'A' : '_');
+        break;
+    }
+    case V_HEX8: { /* the GS_WARN_* bits in hex */
+        uint32_t b;
+        memcpy(&b, p, sizeof b);
+        c[n++] = k_hex_upper[(b >> 4) & 15u];
+        c[n++] = k_hex_upper[b & 15u];
+        break;
+    }
+    default: { /* V_TEXT */
+        const char *s;
+        memcpy(&s, p, sizeof s);
+        n_text(w, s ? s : k_version, f->a);
+        break;
+    }
+    }
+    w_raw(w, c, n);
+}
+
+#define NF(type, name, kind, a, b) {(uint8_t)offsetof(type, name), kind, a, b}
+
+/* every sentence's fields, each after a comma, event by event (docs/protocol.md).
+ * Widths keep a sentence within 82 characters: $GSJMP 10+5+8+9+6+5+6+10+1+1 = 61
+ * = 82 - "$GSJMP" - 10 commas - "*HH\r\n"; $GSSES 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - 6 - 10 - 5. */
+static const field k_nmea_fields[] = {
+#define N_START 0
+    NF(gs_ev_start, version, V_TEXT, 20, 0),
+    NF(gs_ev_start, fps_source, V_FIXED, 3, 10),
+#define N_JUMP 2
+    NF(gs_ev_jump, t_takeoff_s, V_FIXED, 3, 10),
+    NF(gs_ev_jump, flight_time_s, V_FIXED, 3, 5),
+    NF(gs_ev_jump, a_px_s2, V_FIXED, 1, 8),
+    NF(gs_ev_jump, q_m_per_px, V_FIXED, 7, 9),
+    NF(gs_ev_jump, height_m, V_FIXED, 3, 6),
+    NF(gs_ev_jump, jump_height_m, V_FIXED, 3, 5),
+    NF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 2, 6),
+    NF(gs_ev_jump, n_samples, V_U32, 0, 0),
+    NF(gs_ev_jump, accepted, V_FLAG, 'A', 'R'),
+    NF(gs_ev_jump, reason, V_DIGIT, 0, 0),
+#define N_HEIGHT 12
+    NF(gs_ev_height, height_m, V_FIXED, 4, 12),
+    NF(gs_ev_height, ci95_lo_m, V_FIXED, 4, 12),
+    NF(gs_ev_height, ci95_hi_m, V_FIXED, 4, 12),
+    NF(gs_ev_height, n_jumps, V_U32, 0, 0),
+#define N_HEIGHT_END 16 /* the summary adds n_rejected */
+    NF(gs_ev_height, n_rejected, V_U32, 0, 0),
+#define N_SESSION 17
+    NF(gs_ev_session, session, V_U32, 0, 5),
+    NF(gs_ev_session, ended, V_FLAG, 'E', 'S'),
+    NF(gs_ev_session, reason, V_INITIAL, 0, 0),
+    NF(gs_ev_session, t_start_s, V_FIXED, 3, 10),
+    NF(gs_ev_session, t_end_s, V_FIXED, 3, 10),
+    NF(gs_ev_session, stature_m, V_FIXED, 3, 6),
+    NF(gs_ev_session, n_jumps, V_U32, 0, 3),
+    NF(gs_ev_session, best_jump_m, V_FIXED, 3, 5),
+    NF(gs_ev_session, mean_jump_m, V_FIXED, 3, 5),
+    NF(gs_ev_session, mean_flight_s, V_FIXED, 3, 5),
+#define N_WARNING 27
+    NF(gs_ev_warning, t_s, V_FIXED, 3, 10),
+    NF(gs_ev_warning, warnings, V_HEX8, 0, 0),
+#define N_END 29
+};
+_Static_assert(sizeof k_nmea_fields / sizeof k_nmea_fields[0] == N_END, "the N_* indexes match the table");
+
+/* a sentence: $GS, the tag, then fields [first, end); trace events have none */
+static const struct {
+    char tag[4];
+    uint8_t first, end;
+} k_nmea_lines[] = {
+    {"STA", N_START, N_JUMP},          {"JMP", N_JUMP, N_HEIGHT},     {"HGT", N_HEIGHT, N_HEIGHT_END},
+    {"SUM", N_HEIGHT, N_HEIGHT_END + 1}, {"SES", N_SESSION, N_WARNING}, {"WRN", N_WARNING, N_END},
+};
+
+size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
+{
+    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
+    if (w.ok && (unsigned)ev->type >= sizeof k_nmea_lines / sizeof k_nmea_lines[0]) w.ok = false;
+    if (!w.ok) return w_finish(&w);
+    w_raw(&w, "$GS", 3);
+    w_raw(&w, k_nmea_lines[ev->type].tag, 3);
+    for (unsigned i = k_nmea_lines[ev->type].first; i < k_nmea_lines[ev->type].end; i++) {
+        w_raw(&w, ",", 1);
+        w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
+    }
+    if (w.ok) {
+        unsigned char x = 0;
+        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
+        char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
+        w_raw(&w, tail, sizeof tail);
+        if (w.len > NMEA_MAX) w.ok = false; /* cannot happen with the widths above */
+    }
+    return w_finish(&w);
+}
+
+/* ------------------------------------------------------------------ JSON */
 
 /* a JSON string; NULL -> null. Control bytes become \u00XX; valid UTF-8 passes;
  * a byte that is not UTF-8 (a Latin-1 file name) becomes \ufffd, because JSON
@@ -104,41 +323,15 @@ static void w_jstr(gs_w *w, const char *s)
     w_raw(w, "\"", 1);
 }
 
-static void w_fixed(gs_w *w, double v, int decimals)
-{
-    char t[40];
-    size_t n = gs_num_fmt_fixed(t, sizeof t, v, decimals);
-    if (n) w_raw(w, t, n);
-    else w_lit(w, "null"); /* NaN, inf, or beyond 1e15 */
-}
-
-static void w_sig(gs_w *w, double v, int sig)
-{
-    char t[40];
-    size_t n = gs_num_fmt_sig(t, sizeof t, v, sig);
-    if (n) w_raw(w, t, n);
-    else w_lit(w, "null");
-}
-
-static size_t w_finish(gs_w *w)
-{
-    if (!w->ok) {
-        if (w->buf && w->cap) w->buf[0] = '\0';
-        return 0;
-    }
-    w->buf[w->len] = '\0';
-    return w->len;
-}
-
 /* names of the GS_WARN_* bits, in bit order (protocol names) */
 static const char *const k_warn_names[] = {"few_samples", "gravity_tilt", "size_changed", "outliers",
                                            "edge_truncated", "camera_moved", "left_frame", "out_of_plane",
                                            "other_motion"};
 
-/* ,"warnings":[names of the known set bits, in bit order] */
+/* [names of the known set bits, in bit order] */
 static void w_warnings(gs_w *w, uint32_t bits)
 {
-    w_lit(w, ",\"warnings\":[");
+    w_raw(w, "[", 1);
     bool first = true;
     for (uint32_t b = 0; b < sizeof k_warn_names / sizeof k_warn_names[0]; b++) {
         if (!(bits & (1u << b))) continue;
@@ -146,130 +339,180 @@ static void w_warnings(gs_w *w, uint32_t bits)
         w_jstr(w, k_warn_names[b]);
         first = false;
     }
-    w_lit(w, "]");
+    w_raw(w, "]", 1);
 }
 
-/* An event's numbers as a table: the text before the value (key and separator)
- * and where the value is. One loop writes them all (the hand-written sequence of
- * calls cost about 20 bytes of code per field). */
-enum { F_U32 = 0xFF, F_SIG = 0x10 }; /* kind: 0..9 fixed decimals, F_SIG + n significant digits */
-typedef struct {
-    const char *key;
-    uint8_t off;  /* offsetof the double or uint32_t field */
-    uint8_t kind;
-} json_field;
-
-#define JF(type, field, key, kind) {key, (uint8_t)offsetof(type, field), kind}
-_Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "json_field.off is 8 bits");
-
-static void w_fields(gs_w *w, const void *base, const json_field *t, size_t n)
+/* [lo,hi], or null: an interval with an unknown end is no interval */
+static void w_ci95(gs_w *w, const double *mid_lo_hi)
 {
-    for (size_t i = 0; i < n; i++) {
-        const char *p = (const char *)base + t[i].off;
-        w_lit(w, t[i].key);
-        if (t[i].kind == F_U32) {
-            uint32_t v;
-            memcpy(&v, p, sizeof v);
-            w_u32(w, v);
-        } else {
-            double v;
-            memcpy(&v, p, sizeof v);
-            if (t[i].kind >= F_SIG) w_sig(w, v, t[i].kind - F_SIG);
-            else w_fixed(w, v, t[i].kind);
-        }
-    }
-}
-
-static const json_field k_jump_fields[] = {
-    JF(gs_ev_jump, track, "{\"event\":\"jump\",\"track\":", F_U32),
-    JF(gs_ev_jump, index, ",\"index\":", F_U32),
-    JF(gs_ev_jump, t_takeoff_s, ",\"t_takeoff_s\":", 4),
-    JF(gs_ev_jump, t_land_s, ",\"t_land_s\":", 4),
-    JF(gs_ev_jump, flight_time_s, ",\"flight_time_s\":", 4),
-    JF(gs_ev_jump, t_apex_s, ",\"t_apex_s\":", 4),
-    JF(gs_ev_jump, a_px_s2, ",\"a_px_s2\":", F_SIG + 6),
-    JF(gs_ev_jump, a_px_se_s2, ",\"a_px_se_s2\":", F_SIG + 6),
-    JF(gs_ev_jump, g_dir_deg, ",\"g_dir_deg\":", 2),
-    JF(gs_ev_jump, q_m_per_px, ",\"q_m_per_px\":", F_SIG + 6),
-    JF(gs_ev_jump, size_px, ",\"size_px\":", 2),
-    JF(gs_ev_jump, height_m, ",\"height_m\":", 4),
-    JF(gs_ev_jump, height_se_m, ",\"height_se_m\":", 4),
-    JF(gs_ev_jump, jump_height_m, ",\"jump_height_m\":", 4),
-    JF(gs_ev_jump, takeoff_velocity_m_s, ",\"takeoff_velocity_m_s\":", 3),
-    JF(gs_ev_jump, n_samples, ",\"n_samples\":", F_U32),
-    JF(gs_ev_jump, n_outliers, ",\"n_outliers\":", F_U32),
-    JF(gs_ev_jump, rms_px, ",\"rms_px\":", 3),
-};
-
-static void json_jump(gs_w *w, const gs_ev_jump *j)
-{
-    w_fields(w, j, k_jump_fields, sizeof k_jump_fields / sizeof k_jump_fields[0]);
-    w_lit(w, j->accepted ? ",\"accepted\":true,\"reason\":" : ",\"accepted\":false,\"reason\":");
-    w_jstr(w, j->accepted ? NULL : gs_reject_reason_name(j->reason));
-    w_warnings(w, j->warnings);
-    w_lit(w, "}\n");
-}
-
-/* ,"ci95_m":[lo,hi], or null: an interval with an unknown end is no interval */
-static void w_ci95(gs_w *w, double mid, double lo, double hi)
-{
-    w_lit(w, ",\"ci95_m\":");
-    if (isfinite(lo) && isfinite(hi) && isfinite(mid)) {
+    double v[3];
+    memcpy(v, mid_lo_hi, sizeof v);
+    if (gs_dfinite(v[1]) && gs_dfinite(v[2]) && gs_dfinite(v[0])) {
         w_raw(w, "[", 1);
-        w_fixed(w, lo, 4);
+        w_fixed(w, v[1], 4, 0);
         w_raw(w, ",", 1);
-        w_fixed(w, hi, 4);
+        w_fixed(w, v[2], 4, 0);
         w_raw(w, "]", 1);
     } else {
         w_lit(w, "null");
     }
 }
 
-static const json_field k_height_counts[] = {
-    JF(gs_ev_height, n_jumps, ",\"n_jumps\":", F_U32),
-    JF(gs_ev_height, n_rejected, ",\"n_rejected\":", F_U32),
-};
+static const char *const k_json_bool[][2] = {{"true", "false"}, {"\"end\"", "\"start\""}};
 
-static void json_height(gs_w *w, const gs_ev_height *h, bool summary)
+static void w_json_value(gs_w *w, const void *base, const field *f)
 {
-    w_lit(w, summary ? "{\"event\":\"summary\",\"track\":" : "{\"event\":\"height\",\"track\":");
-    w_u32(w, h->track);
-    w_lit(w, ",\"height_m\":");
-    w_fixed(w, h->height_m, 4);
-    w_ci95(w, h->height_m, h->ci95_lo_m, h->ci95_hi_m);
-    w_fields(w, h, k_height_counts, 2);
-    w_lit(w, "}\n");
+    if (w_common(w, base, f)) return;
+    const void *p = field_at(base, f);
+    double d;
+    float x;
+    const char *s;
+    bool b;
+    switch (f->kind) {
+    case V_SIG:
+        memcpy(&d, p, sizeof d);
+        char t[40];
+        size_t n = gs_num_fmt_sig(t, sizeof t, d, f->a);
+        if (n) w_raw(w, t, n);
+        else w_lit(w, "null");
+        break;
+    case V_FLOAT:
+        memcpy(&x, p, sizeof x);
+        w_fixed(w, (double)x, f->a, 0);
+        break;
+    case V_STR:
+        memcpy(&s, p, sizeof s);
+        w_jstr(w, s || !f->a ? s : k_version);
+        break;
+    case V_BOOL:
+        memcpy(&b, p, sizeof b);
+        w_lit(w, k_json_bool[f->a][b ? 0 : 1]);
+        break;
+    case V_REASON: {
+        const gs_ev_jump *j = (const gs_ev_jump *)base;
+        w_jstr(w, j->accepted ? NULL : gs_reject_reason_name(j->reason));
+        break;
+    }
+    case V_WARNINGS: {
+        uint32_t bits;
+        memcpy(&bits, p, sizeof bits);
+        w_warnings(w, bits);
+        break;
+    }
+    default: w_ci95(w, (const double *)p); break;
+    }
 }
 
-static const json_field k_session_head[] = {
-    JF(gs_ev_session, track, "{\"event\":\"session\",\"track\":", F_U32),
-    JF(gs_ev_session, session, ",\"session\":", F_U32),
-};
-static const json_field k_session_times[] = {
-    JF(gs_ev_session, t_start_s, ",\"t_start_s\":", 4),
-    JF(gs_ev_session, t_end_s, ",\"t_end_s\":", 4),
-    JF(gs_ev_session, stature_m, ",\"stature_m\":", 4),
-};
-static const json_field k_session_tail[] = {
-    JF(gs_ev_session, n_jumps, ",\"n_jumps\":", F_U32),
-    JF(gs_ev_session, n_rejected, ",\"n_rejected\":", F_U32),
-    JF(gs_ev_session, best_jump_m, ",\"best_jump_m\":", 4),
-    JF(gs_ev_session, mean_jump_m, ",\"mean_jump_m\":", 4),
-    JF(gs_ev_session, best_flight_s, ",\"best_flight_s\":", 4),
-    JF(gs_ev_session, mean_flight_s, ",\"mean_flight_s\":", 4),
-    JF(gs_ev_session, mean_takeoff_velocity_m_s, ",\"mean_takeoff_velocity_m_s\":", 3),
-};
+/* a JSON field: ,"name": and the value */
+typedef struct {
+    const char *name;
+    field f;
+} json_field;
 
-static void json_session(gs_w *w, const gs_ev_session *e)
-{
-    w_fields(w, e, k_session_head, 2);
-    w_lit(w, e->ended ? ",\"state\":\"end\",\"reason\":" : ",\"state\":\"start\",\"reason\":");
-    w_jstr(w, e->reason);
-    w_fields(w, e, k_session_times, 3);
-    w_ci95(w, e->stature_m, e->ci95_lo_m, e->ci95_hi_m);
-    w_fields(w, e, k_session_tail, sizeof k_session_tail / sizeof k_session_tail[0]);
-    w_lit(w, "}\n");
-}
+#define JF(type, name, kind, a) {#name, {(uint8_t)offsetof(type, name), kind, a, 0}}
+#define JFX(type, name, at, kind, a) {name, {(uint8_t)offsetof(type, at), kind, a, 0}}
+
+_Static_assert(offsetof(gs_ev_height, ci95_lo_m) == offsetof(gs_ev_height, height_m) + sizeof(double) &&
+                   offsetof(gs_ev_height, ci95_hi_m) == offsetof(gs_ev_height, height_m) + 2 * sizeof(double) &&
+                   offsetof(gs_ev_session, ci95_lo_m) == offsetof(gs_ev_session, stature_m) + sizeof(double) &&
+                   offsetof(gs_ev_session, ci95_hi_m) == offsetof(gs_ev_session, stature_m) + 2 * sizeof(double),
+               "V_CI95 reads mid, lo, hi in a row");
+
+/* every line's fields, event by event (docs/protocol.md) */
+static const json_field k_json_fields[] = {
+#define J_START 0
+    JF(gs_ev_start, version, V_STR, 1),
+    JF(gs_ev_start, config, V_STR, 0),
+    JF(gs_ev_start, fps_source, V_SIG, 6),
+    JF(gs_ev_start, fps_origin, V_STR, 0),
+    JF(gs_ev_start, layout, V_STR, 0),
+#define J_JUMP 5
+    JF(gs_ev_jump, track, V_U32, 0),
+    JF(gs_ev_jump, index, V_U32, 0),
+    JF(gs_ev_jump, t_takeoff_s, V_FIXED, 4),
+    JF(gs_ev_jump, t_land_s, V_FIXED, 4),
+    JF(gs_ev_jump, flight_time_s, V_FIXED, 4),
+    JF(gs_ev_jump, t_apex_s, V_FIXED, 4),
+    JF(gs_ev_jump, a_px_s2, V_SIG, 6),
+    JF(gs_ev_jump, a_px_se_s2, V_SIG, 6),
+    JF(gs_ev_jump, g_dir_deg, V_FIXED, 2),
+    JF(gs_ev_jump, q_m_per_px, V_SIG, 6),
+    JF(gs_ev_jump, size_px, V_FIXED, 2),
+    JF(gs_ev_jump, height_m, V_FIXED, 4),
+    JF(gs_ev_jump, height_se_m, V_FIXED, 4),
+    JF(gs_ev_jump, jump_height_m, V_FIXED, 4),
+    JF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 3),
+    JF(gs_ev_jump, n_samples, V_U32, 0),
+    JF(gs_ev_jump, n_outliers, V_U32, 0),
+    JF(gs_ev_jump, rms_px, V_FIXED, 3),
+    JF(gs_ev_jump, accepted, V_BOOL, 0),
+    JF(gs_ev_jump, reason, V_REASON, 0),
+    JF(gs_ev_jump, warnings, V_WARNINGS, 0),
+#define J_HEIGHT 26
+    JF(gs_ev_height, track, V_U32, 0),
+    JF(gs_ev_height, height_m, V_FIXED, 4),
+    JFX(gs_ev_height, "ci95_m", height_m, V_CI95, 0),
+    JF(gs_ev_height, n_jumps, V_U32, 0),
+    JF(gs_ev_height, n_rejected, V_U32, 0),
+#define J_SESSION 31
+    JF(gs_ev_session, track, V_U32, 0),
+    JF(gs_ev_session, session, V_U32, 0),
+    JFX(gs_ev_session, "state", ended, V_BOOL, 1),
+    JF(gs_ev_session, reason, V_STR, 0),
+    JF(gs_ev_session, t_start_s, V_FIXED, 4),
+    JF(gs_ev_session, t_end_s, V_FIXED, 4),
+    JF(gs_ev_session, stature_m, V_FIXED, 4),
+    JFX(gs_ev_session, "ci95_m", stature_m, V_CI95, 0),
+    JF(gs_ev_session, n_jumps, V_U32, 0),
+    JF(gs_ev_session, n_rejected, V_U32, 0),
+    JF(gs_ev_session, best_jump_m, V_FIXED, 4),
+    JF(gs_ev_session, mean_jump_m, V_FIXED, 4),
+    JF(gs_ev_session, best_flight_s, V_FIXED, 4),
+    JF(gs_ev_session, mean_flight_s, V_FIXED, 4),
+    JF(gs_ev_session, mean_takeoff_velocity_m_s, V_FIXED, 3),
+#define J_WARNING 46
+    JF(gs_ev_warning, track, V_U32, 0),
+    JF(gs_ev_warning, t_s, V_FIXED, 4),
+    JF(gs_ev_warning, warnings, V_WARNINGS, 0),
+#define J_TRACE 49
+#if GS_WITH_TRACE /* trace events (gs_features.h): without them, no form (returns 0) */
+#define J_STATE J_TRACE
+    JF(gs_ev_state, t_s, V_FIXED, 4),
+    JF(gs_ev_state, from, V_STR, 0),
+    JF(gs_ev_state, to, V_STR, 0),
+#define J_SAMPLE 52
+    JF(gs_ev_sample, t_s, V_FIXED, 4),
+    JF(gs_ev_sample, x_px, V_FLOAT, 2),
+    JF(gs_ev_sample, y_px, V_FLOAT, 2),
+    JF(gs_ev_sample, w, V_FLOAT, 3),
+    JF(gs_ev_sample, size_px, V_FLOAT, 2),
+    JF(gs_ev_sample, upright, V_FLOAT, 3),
+#define J_FIT 58
+    JF(gs_ev_fit, purpose, V_STR, 0),
+    JF(gs_ev_fit, t_first_s, V_FIXED, 4),
+    JF(gs_ev_fit, t_last_s, V_FIXED, 4),
+    JF(gs_ev_fit, n, V_U32, 0),
+    JF(gs_ev_fit, a_px_s2, V_SIG, 6),
+    JF(gs_ev_fit, g_dir_deg, V_FIXED, 2),
+    JF(gs_ev_fit, rms_px, V_FIXED, 3),
+#define J_END 65
+#else
+#define J_END J_TRACE
+#endif
+};
+_Static_assert(sizeof k_json_fields / sizeof k_json_fields[0] == J_END, "the J_* indexes match the table");
+
+/* a line: {"event":"name", then fields [first, end) */
+static const struct {
+    const char *name;
+    uint8_t first, end;
+} k_json_lines[] = {
+    {"start", J_START, J_JUMP},        {"jump", J_JUMP, J_HEIGHT},         {"height", J_HEIGHT, J_SESSION},
+    {"summary", J_HEIGHT, J_SESSION},  {"session", J_SESSION, J_WARNING},  {"warning", J_WARNING, J_TRACE},
+#if GS_WITH_TRACE
+    {"state", J_STATE, J_SAMPLE},      {"sample", J_SAMPLE, J_FIT},        {"fit", J_FIT, J_END},
+#endif
+};
 
 size_t gs_emit_json_str(const char *s, char *buf, size_t cap)
 {
@@ -281,221 +524,18 @@ size_t gs_emit_json_str(const char *s, char *buf, size_t cap)
 size_t gs_emit_json(const gs_event *ev, char *buf, size_t cap)
 {
     gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
+    if (w.ok && (unsigned)ev->type >= sizeof k_json_lines / sizeof k_json_lines[0]) w.ok = false;
     if (!w.ok) return w_finish(&w);
-    switch (ev->type) {
-    case GS_EV_START: {
-        const gs_ev_start *s = &ev->u.start;
-        w_lit(&w, "{\"event\":\"start\",\"version\":");
-        w_jstr(&w, s->version ? s->version : GS_VERSION);
-        w_lit(&w, ",\"config\":");
-        w_jstr(&w, s->config);
-        w_lit(&w, ",\"fps_source\":");
-        w_sig(&w, s->fps_source, 6);
-        w_lit(&w, ",\"fps_origin\":");
-        w_jstr(&w, s->fps_origin);
-        w_lit(&w, ",\"layout\":");
-        w_jstr(&w, s->layout);
-        w_lit(&w, "}\n");
-        break;
+    w_lit(&w, "{\"event\":\"");
+    w_lit(&w, k_json_lines[ev->type].name);
+    w_raw(&w, "\"", 1);
+    for (unsigned i = k_json_lines[ev->type].first; i < k_json_lines[ev->type].end; i++) {
+        w_raw(&w, ",\"", 2);
+        w_lit(&w, k_json_fields[i].name);
+        w_raw(&w, "\":", 2);
+        w_json_value(&w, &ev->u, &k_json_fields[i].f);
     }
-    case GS_EV_JUMP: json_jump(&w, &ev->u.jump); break;
-    case GS_EV_HEIGHT: json_height(&w, &ev->u.height, false); break;
-    case GS_EV_SUMMARY: json_height(&w, &ev->u.height, true); break;
-    case GS_EV_SESSION: json_session(&w, &ev->u.session); break;
-    case GS_EV_WARNING:
-        w_lit(&w, "{\"event\":\"warning\",\"track\":");
-        w_u32(&w, ev->u.warning.track);
-        w_lit(&w, ",\"t_s\":");
-        w_fixed(&w, ev->u.warning.t_s, 4);
-        w_warnings(&w, ev->u.warning.warnings);
-        w_lit(&w, "}\n");
-        break;
-#if GS_WITH_TRACE /* trace events (gs_features.h): without them, no form (returns 0) */
-    case GS_EV_STATE: {
-        const gs_ev_state *s = &ev->u.state;
-        w_lit(&w, "{\"event\":\"state\",\"t_s\":");
-        w_fixed(&w, s->t_s, 4);
-        w_lit(&w, ",\"from\":");
-        w_jstr(&w, s->from);
-        w_lit(&w, ",\"to\":");
-        w_jstr(&w, s->to);
-        w_lit(&w, "}\n");
-        break;
-    }
-    case GS_EV_SAMPLE: {
-        const gs_ev_sample *s = &ev->u.sample;
-        w_lit(&w, "{\"event\":\"sample\",\"t_s\":");
-        w_fixed(&w, s->t_s, 4);
-        w_lit(&w, ",\"x_px\":");
-        w_fixed(&w, (double)s->x_px, 2);
-        w_lit(&w, ",\"y_px\":");
-        w_fixed(&w, (double)s->y_px, 2);
-        w_lit(&w, ",\"w\":");
-        w_fixed(&w, (double)s->w, 3);
-        w_lit(&w, ",\"size_px\":");
-        w_fixed(&w, (double)s->size_px, 2);
-        w_lit(&w, ",\"upright\":");
-        w_fixed(&w, (double)s->upright, 3);
-        w_lit(&w, "}\n");
-        break;
-    }
-    case GS_EV_FIT: {
-        const gs_ev_fit *f = &ev->u.fit;
-        w_lit(&w, "{\"event\":\"fit\",\"purpose\":");
-        w_jstr(&w, f->purpose);
-        w_lit(&w, ",\"t_first_s\":");
-        w_fixed(&w, f->t_first_s, 4);
-        w_lit(&w, ",\"t_last_s\":");
-        w_fixed(&w, f->t_last_s, 4);
-        w_lit(&w, ",\"n\":");
-        w_u32(&w, f->n);
-        w_lit(&w, ",\"a_px_s2\":");
-        w_sig(&w, f->a_px_s2, 6);
-        w_lit(&w, ",\"g_dir_deg\":");
-        w_fixed(&w, f->g_dir_deg, 2);
-        w_lit(&w, ",\"rms_px\":");
-        w_fixed(&w, f->rms_px, 3);
-        w_lit(&w, "}\n");
-        break;
-    }
-#endif
-    default: w.ok = false; break;
-    }
-    return w_finish(&w);
-}
-
-/* ------------------------------------------------------------------ NMEA */
-
-/* A number in at most `width` characters: `decimals` decimals, fewer when the
- * value is large, empty when it is unknown or cannot fit (keeps <= 82 chars). */
-static void n_num(gs_w *w, double v, int decimals, size_t width)
-{
-    w_raw(w, ",", 1);
-    if (!isfinite(v)) return;
-    for (int d = decimals; d >= 0; d--) {
-        char t[40];
-        size_t n = gs_num_fmt_fixed(t, sizeof t, v, d);
-        if (n && n <= width) {
-            w_raw(w, t, n);
-            return;
-        }
-    }
-}
-
-/* fields of a sentence from a table, as json_field: offset, decimals and width of a double */
-typedef struct {
-    uint8_t off, decimals, width;
-} nmea_field;
-#define NF(type, field, dec, width) {(uint8_t)offsetof(type, field), dec, width}
-
-static void n_fields(gs_w *w, const void *base, const nmea_field *t, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        double v;
-        memcpy(&v, (const char *)base + t[i].off, sizeof v);
-        n_num(w, v, t[i].decimals, t[i].width);
-    }
-}
-
-static void n_u32(gs_w *w, uint32_t v)
-{
-    w_raw(w, ",", 1);
-    w_u32(w, v);
-}
-
-/* NMEA text fields may not hold the delimiters $ * , ! \ ^ ~ or non-printables */
-static void n_text(gs_w *w, const char *s, size_t max_len)
-{
-    w_raw(w, ",", 1);
-    for (size_t i = 0; s && s[i] && i < max_len; i++) {
-        char c = s[i];
-        /* NMEA's reserved characters (not strchr: no libc search linked for this) */
-        if (c < 0x20 || c > 0x7e || c == '$' || c == '*' || c == ',' || c == '!' || c == '\\' || c == '^' ||
-            c == '~')
-            c = '_';
-        w_raw(w, &c, 1);
-    }
-}
-
-size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
-{
-    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
-    if (!w.ok) return w_finish(&w);
-    switch (ev->type) {
-    case GS_EV_JUMP: {
-        /* widths: 10+5+8+9+6+5+6+10+1+1 = 61 = 82 - "$GSJMP" - 10 commas - "*HH\r\n" */
-        static const nmea_field k_jmp[] = {
-            NF(gs_ev_jump, t_takeoff_s, 3, 10), NF(gs_ev_jump, flight_time_s, 3, 5),
-            NF(gs_ev_jump, a_px_s2, 1, 8),      NF(gs_ev_jump, q_m_per_px, 7, 9),
-            NF(gs_ev_jump, height_m, 3, 6),     NF(gs_ev_jump, jump_height_m, 3, 5),
-            NF(gs_ev_jump, takeoff_velocity_m_s, 2, 6)};
-        const gs_ev_jump *j = &ev->u.jump;
-        w_lit(&w, "$GSJMP");
-        n_fields(&w, j, k_jmp, sizeof k_jmp / sizeof k_jmp[0]);
-        n_u32(&w, j->n_samples);
-        w_lit(&w, j->accepted ? ",A" : ",R");
-        w_raw(&w, ",", 1);
-        if ((uint32_t)j->reason <= 9u) {
-            char c = (char)('0' + (int)j->reason);
-            w_raw(&w, &c, 1);
-        }
-        break;
-    }
-    case GS_EV_HEIGHT:
-    case GS_EV_SUMMARY: {
-        const gs_ev_height *h = &ev->u.height;
-        static const nmea_field k_hgt[] = {NF(gs_ev_height, height_m, 4, 12), NF(gs_ev_height, ci95_lo_m, 4, 12),
-                                           NF(gs_ev_height, ci95_hi_m, 4, 12)};
-        w_lit(&w, ev->type == GS_EV_HEIGHT ? "$GSHGT" : "$GSSUM");
-        n_fields(&w, h, k_hgt, 3);
-        n_u32(&w, h->n_jumps);
-        if (ev->type == GS_EV_SUMMARY) n_u32(&w, h->n_rejected);
-        break;
-    }
-    case GS_EV_SESSION: {
-        /* widths: 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - "$GSSES" - 10 commas - "*HH\r\n" */
-        const gs_ev_session *e = &ev->u.session;
-        w_lit(&w, "$GSSES");
-        n_num(&w, (double)e->session, 0, 5);
-        w_lit(&w, e->ended ? ",E," : ",S,");
-        if (e->reason) {
-            char c = (char)(e->reason[0] >= 'a' && e->reason[0] <= 'z' ? e->reason[0] - 'a' + 'A' : '_');
-            w_raw(&w, &c, 1);  /* A absence, N new_body, E end_of_stream */
-        }
-        static const nmea_field k_ses_t[] = {NF(gs_ev_session, t_start_s, 3, 10), NF(gs_ev_session, t_end_s, 3, 10),
-                                             NF(gs_ev_session, stature_m, 3, 6)};
-        static const nmea_field k_ses_j[] = {NF(gs_ev_session, best_jump_m, 3, 5), NF(gs_ev_session, mean_jump_m, 3, 5),
-                                             NF(gs_ev_session, mean_flight_s, 3, 5)};
-        n_fields(&w, e, k_ses_t, 3);
-        n_num(&w, (double)e->n_jumps, 0, 3);
-        n_fields(&w, e, k_ses_j, 3);
-        break;
-    }
-    case GS_EV_WARNING: {
-        static const char hexd[] = "0123456789ABCDEF";
-        uint32_t b = ev->u.warning.warnings & 0xFFu;
-        char hx[2] = {hexd[b >> 4], hexd[b & 15u]};
-        w_lit(&w, "$GSWRN");
-        n_num(&w, ev->u.warning.t_s, 3, 10);
-        w_raw(&w, ",", 1);
-        w_raw(&w, hx, 2);  /* the GS_WARN_* bits in hex */
-        break;
-    }
-    case GS_EV_START:
-        w_lit(&w, "$GSSTA");
-        n_text(&w, ev->u.start.version ? ev->u.start.version : GS_VERSION, 20);
-        n_num(&w, ev->u.start.fps_source, 3, 10);
-        break;
-    default: w.ok = false; break; /* trace events have no sentence */
-    }
-    if (w.ok) {
-        static const char hex[] = "0123456789ABCDEF";
-        unsigned char x = 0;
-        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
-        char tail[5] = {'*', hex[x >> 4], hex[x & 15u], '\r', '\n'};
-        w_raw(&w, tail, sizeof tail);
-        if (w.len > NMEA_MAX) w.ok = false; /* cannot happen with the widths above */
-    }
+    w_lit(&w, "}\n");
     return w_finish(&w);
 }
 

@@ -9,6 +9,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_dbits.h"
+
 /* 124 x 32 bits hold D * 2^s for 800 digits against 10^1124 (see parse_slow). */
 #define BIG_W 124
 /* Digits kept exactly by the slow parser; more become one sticky digit
@@ -19,11 +21,6 @@ typedef struct {
     uint32_t n;          /* words in use, w[n-1] != 0 unless n == 0 */
     uint32_t w[BIG_W];   /* little-endian base 2^32 */
 } gs_big;
-
-/* 10^0..10^22 are exact doubles, so one multiply or divide rounds once. */
-static const double k_pow10_dbl[23] = {
-    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
-    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
 static const uint32_t k_pow10_u32[10] = {1u,      10u,      100u,      1000u,      10000u,
                                          100000u, 1000000u, 10000000u, 100000000u, 1000000000u};
@@ -60,13 +57,6 @@ static bool big_mul_pow10(gs_big *b, uint32_t k)
     for (; k >= 9; k -= 9)
         if (!big_mul_add(b, 1000000000u, 0)) return false;
     return k ? big_mul_add(b, k_pow10_u32[k], 0) : true;
-}
-
-static bool big_mul_pow5(gs_big *b, uint32_t k)
-{
-    for (; k >= 13; k -= 13)
-        if (!big_mul_add(b, 1220703125u, 0)) return false;
-    return k ? big_mul_add(b, k_pow5_u32[k], 0) : true;
 }
 
 static uint32_t bitlen32(uint32_t x)
@@ -201,26 +191,29 @@ static bool round_to_double(uint64_t q, bool sticky, int64_t s, bool neg, double
     while (k > 1000) { r *= pow2(1000); k -= 1000; }
     while (k < -1000) { r *= pow2(-1000); k += 1000; }
     r *= pow2((int)k);
-    if (isinf(r)) return false;
+    if (!gs_dfinite(r)) return false;
     *out = neg ? -r : r;
     return true;
 }
 
 /* Exact conversion of the digits in s[0..mant_len) (with an optional '.')
- * times 10^exp10_in. nsig > 0 significant digits. */
-static bool parse_slow(const char *s, size_t mant_len, int64_t nsig, int64_t nfrac,
-                       int64_t exp10_in, bool neg, double *out)
+ * times 10^exp10_in; at least one digit is not 0. */
+static bool parse_slow(const char *s, size_t mant_len, int64_t exp10_in, bool neg, double *out)
 {
     gs_big d, v;
     big_set(&d, 0);
-    int64_t taken = 0;
-    bool tail = false;
+    int64_t nsig = 0, nfrac = 0, taken = 0;
+    bool point = false, tail = false;
     uint32_t chunk = 0, chunk_n = 0;
     for (size_t i = 0; i < mant_len; i++) {
-        char c = s[i];
-        if (c < '0' || c > '9') continue;
-        uint32_t dig = (uint32_t)(c - '0');
-        if (taken == 0 && dig == 0) continue;
+        if (s[i] == '.') {
+            point = true;
+            continue;
+        }
+        uint32_t dig = (uint32_t)(s[i] - '0');
+        if (point) nfrac++;
+        if (nsig == 0 && dig == 0) continue; /* leading zeros */
+        nsig++;
         if (taken < PARSE_MAX_DIGITS - 1) {
             chunk = chunk * 10u + dig;
             taken++;
@@ -298,15 +291,28 @@ static bool parse_slow(const char *s, size_t mant_len, int64_t nsig, int64_t nfr
     return round_to_double(q, sticky, sh, neg, out);
 }
 
-/* m * 10^e10 by scaling in double (m <= 19 digits): a few roundings, within 16 ulp
- * of the correctly rounded value (relative 4e-15; subnormals lose more). */
-static bool scale_pow10(uint64_t m, int64_t e10, bool neg, double *out)
+/* 10^k: for k <= 22 every product is an exact double, so this is the literal
+ * (no 184-byte table) */
+static double pow10_exact(int k)
 {
-    double r = (double)m;
-    for (; e10 > 22; e10 -= 22) r *= 1e22;
-    for (; e10 < -22 && r != 0.0; e10 += 22) r /= 1e22;
-    if (e10 >= -22) r = e10 < 0 ? r / k_pow10_dbl[-e10] : r * k_pow10_dbl[e10];
-    if (isinf(r)) return false;
+    double p = 1.0;
+    while (k-- > 0) p *= 10.0;
+    return p;
+}
+
+/* m * 10^e10 by scaling in double (m <= 19 digits): a few roundings, within 16 ulp
+ * of the correctly rounded value (relative 4e-15; subnormals lose more). With
+ * m <= 2^53 and |e10| <= 22 it is the one rounding of the exact fast path. */
+static bool scale_pow10(uint64_t m, int e10, bool neg, double *out)
+{
+    double r = (double)m; /* m > 0 */
+    bool down = e10 < 0;
+    int k = down ? -e10 : e10;
+    /* 10^22 at a time; an underflow to 0 stays 0 (and 0 / 10^k is 0) */
+    for (; k > 22 && r != 0.0; k -= 22) r = down ? r / 1e22 : r * 1e22;
+    double p = pow10_exact(k);
+    r = down ? r / p : r * p;
+    if (!gs_dfinite(r)) return false;
     *out = neg ? -r : r;
     return true;
 }
@@ -334,22 +340,20 @@ static bool parse_impl(const char *s, size_t len, double *out, bool exact)
         i++;
     }
     size_t mant_start = i;
+    /* the first 19 significant digits in m, the value = m * 10^(exp_adj + exponent);
+     * ptrdiff_t: counts of an object's characters (32-bit arithmetic on an M4) */
     uint64_t m = 0;
     int nkept = 0;
-    int64_t nsig = 0, nfrac = 0, exp_adj = 0, ndig = 0;
-    bool point = false, tail = false;
+    ptrdiff_t exp_adj = 0;
+    bool point = false, tail = false, digits = false;
     for (; i < len; i++) {
         char c = s[i];
         if (c >= '0' && c <= '9') {
             unsigned dg = (unsigned)(c - '0');
-            ndig++;
-            if (point) nfrac++;
-            if (nsig == 0 && dg == 0) {
+            digits = true;
+            if (m == 0 && dg == 0) { /* a leading zero (m == 0 until the first other digit) */
                 if (point) exp_adj--;
-                continue;
-            }
-            nsig++;
-            if (nkept < 19) {
+            } else if (nkept < 19) {
                 m = m * 10u + dg;
                 nkept++;
                 if (point) exp_adj--;
@@ -363,9 +367,9 @@ static bool parse_impl(const char *s, size_t len, double *out, bool exact)
             break;
         }
     }
-    if (ndig == 0) return false;
+    if (!digits) return false;
     size_t mant_end = i;
-    int64_t e = 0;
+    int e = 0;
     if (i < len && (s[i] == 'e' || s[i] == 'E')) {
         i++;
         bool eneg = false;
@@ -380,52 +384,28 @@ static bool parse_impl(const char *s, size_t len, double *out, bool exact)
         if (eneg) e = -e;
     }
     if (i != len) return false;
-    if (nsig == 0) {
-        *out = neg ? -0.0 : 0.0;
-        return true;
-    }
-    int64_t e10 = exp_adj + e;
+    int64_t e10 = (int64_t)exp_adj + e;
     int64_t dec_exp = e10 + nkept; /* value < 10^dec_exp */
-    if (dec_exp > 310) return false;
-    if (dec_exp < -324) {
+    if (m == 0 || dec_exp < -324) { /* all digits zero, or below half the smallest subnormal */
         *out = neg ? -0.0 : 0.0;
         return true;
     }
-    if (!tail) {
-        const uint64_t two53 = 1ull << 53;
-        if (m <= two53) {
-            if (e10 >= -22 && e10 <= 22) {
-                double r = (double)m;
-                r = e10 < 0 ? r / k_pow10_dbl[-e10] : r * k_pow10_dbl[e10];
-                *out = neg ? -r : r;
-                return true;
-            }
-            if (e10 > 22 && e10 <= 22 + 15) {
-                uint64_t mm = m;
-                bool ok = true;
-                for (int64_t k = 0; k < e10 - 22 && ok; k++) {
-                    if (mm > two53 / 10u) ok = false;
-                    else mm *= 10u;
-                }
-                if (ok) {
-                    double r = (double)mm * 1e22;
-                    if (isinf(r)) return false;
-                    *out = neg ? -r : r;
-                    return true;
-                }
-            }
-        } else if (!exact && e10 >= -22 && e10 <= 22) {
-            /* 17-19 digits in the scaled parser: two roundings, within 1 ulp. The
-             * exact parser takes the big-integer path: (double)m rounds once
-             * already (m > 2^53), so m * 10^e10 may land 1 ulp off. */
-            double r = (double)m;
-            r = e10 < 0 ? r / k_pow10_dbl[-e10] : r * k_pow10_dbl[e10];
-            *out = neg ? -r : r;
-            return true;
-        }
+    if (dec_exp > 310) return false;
+    /* from here -343 <= e10 <= 310 */
+    const uint64_t two53 = 1ull << 53;
+    if (!tail && m <= two53) {
+        /* m * 10^e10 with m and 10^e10 exact doubles: one rounding. Beyond 10^22
+         * the mantissa takes what it can exactly (1e30 = 10^8 * 1e22). */
+        uint64_t mm = m;
+        int k = (int)e10;
+        for (; k > 22 && mm <= two53 / 10u; k--) mm *= 10u;
+        if (k >= -22 && k <= 22) return scale_pow10(mm, k, neg, out);
     }
-    if (!exact) return scale_pow10(m, e10, neg, out);
-    return parse_slow(s + mant_start, mant_end - mant_start, nsig, nfrac, e, neg, out);
+    /* The scaled parser's 17-19 digits with |e10| <= 22: two roundings, within 1 ulp.
+     * The exact parser takes the big-integer path: (double)m rounds once
+     * already (m > 2^53), so m * 10^e10 may land 1 ulp off. */
+    if (!exact) return scale_pow10(m, (int)e10, neg, out);
+    return parse_slow(s + mant_start, mant_end - mant_start, e, neg, out);
 }
 
 bool gs_num_parse_int(const char *s, size_t len, long *out)
@@ -454,25 +434,23 @@ bool gs_num_parse_int(const char *s, size_t len, long *out)
 
 /* ------------------------------------------------------------------ format */
 
-/* The exact decimal expansion of a > 0: a = N * 10^-p, N in base-1e4 chunks. */
+/* The leading decimal digits of a finite a > 0, exact: a = D * 10^-p with D an
+ * integer of nd digits, of which the first DEC_KEEP are kept (enough for 15
+ * integer digits, 9 decimals and the rounding digit). */
+#define DEC_KEEP 32 /* a power of two: the digits are a ring */
 typedef struct {
-    uint16_t c[204]; /* base-10^4 chunks, c[0] least significant (810 digits) */
-    int nc;
-    int nd;         /* decimal digits of N */
+    char ring[DEC_KEEP]; /* digit j of D counted from the least significant at ring[j % DEC_KEEP] */
+    int nd;
     int p;
 } gs_dec;
 
-static void dec_expand(double a, gs_dec *d)
+static void dec_expand(uint64_t abs_bits, gs_dec *d)
 {
     /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
-    uint64_t bits;
-    memcpy(&bits, &a, sizeof bits);
-    int be = (int)((bits >> 52) & 0x7FFu);
-    uint64_t mant = bits & ((1ull << 52) - 1u);
-    int e2;
-    if (be == 0) {
-        e2 = -1074;  /* subnormal */
-    } else {
+    int be = (int)(abs_bits >> 52);
+    uint64_t mant = abs_bits & ((1ull << 52) - 1u);
+    int e2 = -1074; /* subnormal */
+    if (be) {
         mant |= 1ull << 52;
         e2 = be - 1075;
     }
@@ -482,55 +460,68 @@ static void dec_expand(double a, gs_dec *d)
     }
     gs_big n;
     big_set(&n, mant);
-    /* 2^53 * 5^1074 < 2^2560 and 2^1024 both fit BIG_W words */
-    if (e2 >= 0) {
-        (void)big_shl(&n, (uint32_t)e2);
-        d->p = 0;
-    } else {
-        (void)big_mul_pow5(&n, (uint32_t)(-e2));
-        d->p = -e2;
+    /* a = mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
+    uint32_t k = (uint32_t)(e2 < 0 ? -e2 : e2);
+    d->p = e2 < 0 ? (int)k : 0;
+    for (; k; k -= k < 13u ? k : 13u) {
+        uint32_t step = k < 13u ? k : 13u;
+        (void)big_mul_add(&n, e2 < 0 ? k_pow5_u32[step] : 1u << step, 0);
     }
-    d->nc = 0;
-    while (n.n && d->nc < 204) d->c[d->nc++] = (uint16_t)big_divmod_small(&n, 10000u);
-    uint32_t top = d->c[d->nc - 1];
-    int td = 1;
-    while (td < 4 && top >= k_pow10_u32[td]) td++;
-    d->nd = 4 * (d->nc - 1) + td;
+    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower) */
+    d->nd = 0;
+    while (n.n)
+        for (uint32_t r = big_divmod_small(&n, 10000u), j = 0; j < 4; j++, r /= 10u)
+            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
+    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
-static int dec_digit(const gs_dec *d, int i)
+static char dec_digit(const gs_dec *d, int i)
 {
-    if (i < 0 || i >= d->nd) return 0;
-    int j = d->nd - 1 - i;
-    return (int)((d->c[j / 4] / k_pow10_u32[j % 4]) % 10u);
+    return i >= 0 && i < d->nd && i < DEC_KEEP ? d->ring[(d->nd - 1 - i) & (DEC_KEEP - 1)] : 0;
 }
 
-/* Keep the first n digits (n <= 30) in out[] as values 0..9, rounded half away
- * using digit n. Returns 1 when the rounding carried into a new leading digit. */
+/* Keep the first n digits (n < DEC_KEEP) in out[] as values 0..9, rounded half
+ * away using digit n. On a carry into a new leading digit out[] is 1 and n zeros
+ * (one digit more) and it returns 1. */
 static int dec_round(const gs_dec *d, int n, char *out)
 {
-    for (int i = 0; i < n; i++) out[i] = (char)dec_digit(d, i);
-    if (dec_digit(d, n) < 5) return 0;
-    for (int i = n - 1; i >= 0; i--) {
-        if (out[i] < 9) {
-            out[i]++;
-            return 0;
-        }
-        out[i] = 0;
+    for (int i = 0; i <= n; i++) out[i] = dec_digit(d, i);
+    bool up = out[n] >= 5;
+    out[n] = 0;
+    for (int i = n - 1; up && i >= 0; i--) {
+        up = out[i] == 9;
+        out[i] = up ? 0 : (char)(out[i] + 1);
     }
-    return 1;
+    if (up) out[0] = 1;
+    return up;
 }
 
-static size_t put_fail(char *buf, size_t cap)
+/* "[-]I[.F]" into t from digits dig[0..n) (values 0..9) worth 0.d0d1.. * 10^pt:
+ * the integer part ("0" when pt <= 0), then `frac` digits after a point (no
+ * point when 0). Returns the length. */
+static size_t put_digits(char *t, bool neg, const char *dig, int n, int pt, int frac)
 {
-    if (buf && cap) buf[0] = '\0';
-    return 0;
+    size_t len = 0;
+    if (neg) t[len++] = '-';
+    int i = 0;
+    if (pt <= 0) {
+        t[len++] = '0';
+        i = pt;
+    }
+    for (; i < pt + frac; i++) {
+        if (i == pt) t[len++] = '.';
+        t[len++] = (char)('0' + (i >= 0 && i < n ? dig[i] : 0));
+    }
+    return len;
 }
+
+/* a length no buffer holds: put_out writes "" and returns 0 */
+#define FMT_FAIL SIZE_MAX
 
 static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
 {
-    if (!buf || n + 1u > cap) {
+    if (!buf || n >= cap) {
         if (buf && cap) buf[0] = '\0';
         return 0;
     }
@@ -541,59 +532,32 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
 
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
-    if (!isfinite(v) || fabs(v) >= 1e15 || decimals < 0 || decimals > 9)
-        return put_fail(buf, cap);
-    char buf_dig[32]; /* the integer round(|v| * 10^decimals), most significant first */
-    char *dig = buf_dig + 1;
-    int nd = 0;
-    if (v != 0.0) {
+    uint64_t mag = gs_dbits_abs(v);
+    /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
+    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
+    char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
+    int nr = 0;
+    if (mag) {
         gs_dec d;
-        dec_expand(fabs(v), &d);
+        dec_expand(mag, &d);
         int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
-        if (count >= 0) {
-            int carry = dec_round(&d, count, dig);
-            nd = count;
-            if (carry) { /* a new leading 1 in front (no memmove linked) */
-                dig = buf_dig;
-                dig[0] = 1;
-                nd = count + 1;
-            }
-        }
+        if (count >= 0) nr = count + dec_round(&d, count, dig);
     }
-    int lead = 0;
-    while (lead < nd && dig[lead] == 0) lead++;
-    bool zero = lead == nd;
     char t[48];
-    size_t n = 0;
-    if (v < 0 && !zero) t[n++] = '-';
-    int nr = nd - lead; /* significant digits of the rounded integer */
-    const char *r = dig + lead;
-    if (nr > decimals) {
-        for (int i = 0; i < nr - decimals; i++) t[n++] = (char)('0' + r[i]);
-    } else {
-        t[n++] = '0';
-    }
-    if (decimals > 0) {
-        t[n++] = '.';
-        for (int i = 0; i < decimals - nr; i++) t[n++] = '0';
-        for (int i = nr > decimals ? nr - decimals : 0; i < nr; i++) t[n++] = (char)('0' + r[i]);
-    }
+    size_t n = put_digits(t, nr && (gs_dbits(v) & GS_DBITS_SIGN), dig, nr, nr - decimals, decimals);
     return put_out(buf, cap, t, n);
 }
 
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
 {
-    if (!isfinite(v) || sig < 1 || sig > 15) return put_fail(buf, cap);
-    if (v == 0.0) return put_out(buf, cap, "0", 1u);
+    uint64_t mag = gs_dbits_abs(v);
+    if (mag >= GS_DBITS_INF || sig < 1 || sig > 15) return put_out(buf, cap, "", FMT_FAIL);
+    if (!mag) return put_out(buf, cap, "0", 1u);
     gs_dec d;
-    dec_expand(fabs(v), &d);
-    char dig[32];
+    dec_expand(mag, &d);
+    char dig[DEC_KEEP];
     int k = d.nd - d.p - 1; /* decimal exponent of the first digit */
-    if (dec_round(&d, sig, dig)) {
-        dig[0] = 1;
-        for (int i = 1; i < sig; i++) dig[i] = 0;
-        k++;
-    }
+    k += dec_round(&d, sig, dig); /* a carry: 1 and zeros, cut to sig digits below */
     /* Near the largest double, rounding up can give a decimal that no double
      * is nearest to (1.79e308 to 1 digit: 2e+308; DBL_MAX to 15: 1.79769313486232e+308,
      * beyond DBL_MAX + half an ulp): it would parse back as an overflow. There
@@ -602,37 +566,18 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
      * and for DBL_MAX's first 16 digits, cut and round-up limit are the same. */
     static const char k_max_dig[16] = {1, 7, 9, 7, 6, 9, 3, 1, 3, 4, 8, 6, 2, 3, 1, 5};
     if (k == 308 && memcmp(dig, k_max_dig, (size_t)sig) > 0)
-        for (int i = 0; i < sig; i++) dig[i] = (char)dec_digit(&d, i);
+        for (int i = 0; i < sig; i++) dig[i] = dec_digit(&d, i);
     int nk = sig;
     while (nk > 1 && dig[nk - 1] == 0) nk--;
+    bool neg = gs_dbits(v) & GS_DBITS_SIGN;
     char t[48];
-    size_t n = 0;
-    if (v < 0) t[n++] = '-';
-    if (k >= -4 && k <= 14) {
-        if (k >= 0) {
-            for (int i = 0; i <= k; i++) t[n++] = (char)('0' + (i < nk ? dig[i] : 0));
-            if (nk > k + 1) {
-                t[n++] = '.';
-                for (int i = k + 1; i < nk; i++) t[n++] = (char)('0' + dig[i]);
-            }
-        } else {
-            t[n++] = '0';
-            t[n++] = '.';
-            for (int i = 0; i < -k - 1; i++) t[n++] = '0';
-            for (int i = 0; i < nk; i++) t[n++] = (char)('0' + dig[i]);
-        }
-    } else {
-        t[n++] = (char)('0' + dig[0]);
-        if (nk > 1) {
-            t[n++] = '.';
-            for (int i = 1; i < nk; i++) t[n++] = (char)('0' + dig[i]);
-        }
-        t[n++] = 'e';
-        t[n++] = k < 0 ? '-' : '+';
-        int ak = k < 0 ? -k : k;
-        if (ak >= 100) t[n++] = (char)('0' + ak / 100);
-        t[n++] = (char)('0' + (ak / 10) % 10);
-        t[n++] = (char)('0' + ak % 10);
-    }
+    if (k >= -4 && k <= 14) return put_out(buf, cap, t, put_digits(t, neg, dig, nk, k + 1, nk > k + 1 ? nk - k - 1 : 0));
+    size_t n = put_digits(t, neg, dig, nk, 1, nk - 1);
+    t[n++] = 'e';
+    t[n++] = k < 0 ? '-' : '+';
+    int ak = k < 0 ? -k : k;
+    if (ak >= 100) t[n++] = (char)('0' + ak / 100);
+    t[n++] = (char)('0' + (ak / 10) % 10);
+    t[n++] = (char)('0' + ak % 10);
     return put_out(buf, cap, t, n);
 }

@@ -4,18 +4,16 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_dbits.h"
+
 #define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
 
+/* the per-visit state: every field from gap_since_ref to the end (gs_session.h) */
 static void reset_visit(gs_session *s)
 {
-    s->gap_since_ref = false;
-    s->ref_n = 0;
+    memset(&s->gap_since_ref, 0, sizeof *s - offsetof(gs_session, gap_since_ref));
     s->ref_px = NAN;
-    s->odd_run = 0;
-    s->n_jumps = s->n_rejected = 0;
     s->best_jump_m = s->best_flight_s = NAN;
-    s->sum_jump_m = s->sum_flight_s = s->sum_v_m_s = 0.0;
-    s->n_jump_h = s->n_v = s->n_flight_t = 0;
 }
 
 void gs_session_init(gs_session *s, double absence_s, double new_body_rel)
@@ -29,8 +27,10 @@ void gs_session_init(gs_session *s, double absence_s, double new_body_rel)
     reset_visit(s);
 }
 
-static double median_small(const float *v, uint32_t n)
+/* the median of GS_SESSION_REF_N sizes */
+static double median_ref(const float *v)
 {
+    const uint32_t n = GS_SESSION_REF_N;
     float t[GS_SESSION_REF_N];
     for (uint32_t i = 0; i < n; i++) {
         float x = v[i];
@@ -55,7 +55,7 @@ static uint32_t start(gs_session *s, double t_s)
 
 uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_px, const char **end_reason)
 {
-    if (!s || !isfinite(t_s)) return 0;
+    if (!s || !gs_dfinite(t_s)) return 0;
     if (end_reason) *end_reason = NULL;
     if (!present) {
         if (s->open && t_s - s->t_seen_s >= s->absence_s) {
@@ -67,10 +67,10 @@ uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_
     if (!s->open) return start(s, t_s);
     if (t_s - s->t_seen_s >= s->gap_s && s->ref_n >= GS_SESSION_REF_N) s->gap_since_ref = true;
     s->t_seen_s = t_s;
-    if (!isfinite(stand_px) || !(stand_px > 0.0)) return 0;
+    if (!gs_dpositive(stand_px)) return 0;
     if (s->ref_n < GS_SESSION_REF_N) {
         s->ref_acc[s->ref_n++] = (float)stand_px;
-        if (s->ref_n == GS_SESSION_REF_N) s->ref_px = median_small(s->ref_acc, s->ref_n);
+        if (s->ref_n == GS_SESSION_REF_N) s->ref_px = median_ref(s->ref_acc);
         return 0;
     }
     /* the same person stepping closer changes size while seen; someone else appears after a gap */
@@ -85,6 +85,15 @@ uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_
     return 0;
 }
 
+/* a known value into a sum and its count, and into the best (largest) when given */
+static void tally(double x, double *sum, uint32_t *n, double *best)
+{
+    if (!gs_dfinite(x)) return;
+    *sum += x;
+    ++*n;
+    if (best && !(x <= *best)) *best = x; /* NaN best: the first */
+}
+
 void gs_session_jump(gs_session *s, const gs_ev_jump *j)
 {
     if (!s || !j || !s->open) return;
@@ -93,20 +102,9 @@ void gs_session_jump(gs_session *s, const gs_ev_jump *j)
         return;
     }
     s->n_jumps++;
-    if (isfinite(j->jump_height_m)) {
-        s->sum_jump_m += j->jump_height_m;
-        s->n_jump_h++;
-        if (!(j->jump_height_m <= s->best_jump_m)) s->best_jump_m = j->jump_height_m;  /* NaN best: first */
-    }
-    if (isfinite(j->flight_time_s)) {
-        s->sum_flight_s += j->flight_time_s;
-        s->n_flight_t++;
-        if (!(j->flight_time_s <= s->best_flight_s)) s->best_flight_s = j->flight_time_s;
-    }
-    if (isfinite(j->takeoff_velocity_m_s)) {
-        s->sum_v_m_s += j->takeoff_velocity_m_s;
-        s->n_v++;
-    }
+    tally(j->jump_height_m, &s->sum_jump_m, &s->n_jump_h, &s->best_jump_m);
+    tally(j->flight_time_s, &s->sum_flight_s, &s->n_flight_t, &s->best_flight_s);
+    tally(j->takeoff_velocity_m_s, &s->sum_v_m_s, &s->n_v, NULL);
 }
 
 void gs_session_event(const gs_session *s, bool ended, const char *reason, const gs_ev_height *stature,

@@ -1,0 +1,36 @@
+/* gs_dbits.h - tests of a double from its IEEE bits (private to the text and
+ * bookkeeping files of the core). Where double is emulated (a Cortex-M4F) each
+ * isfinite/isnan/compare is a libgcc call; these are a few integer instructions
+ * and give the same answers. */
+#ifndef GS_DBITS_H
+#define GS_DBITS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
+
+#define GS_DBITS_SIGN 0x8000000000000000ull
+#define GS_DBITS_INF 0x7FF0000000000000ull /* bits of +inf; larger magnitudes are NaN */
+
+static inline uint64_t gs_dbits(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* the bits of |x|: for non-negative doubles, integer order is value order */
+static inline uint64_t gs_dbits_abs(double x) { return gs_dbits(x) & ~GS_DBITS_SIGN; }
+
+/* the exponent field not all ones (a test of the high word only) */
+static inline bool gs_dfinite(double x)
+{
+    return ((uint32_t)(gs_dbits(x) >> 32) & 0x7FF00000u) != 0x7FF00000u;
+}
+
+static inline bool gs_disnan(double x) { return gs_dbits_abs(x) > GS_DBITS_INF; }
+
+/* finite and > 0 (not +-0, not NaN) */
+static inline bool gs_dpositive(double x) { return gs_dbits(x) - 1u < GS_DBITS_INF - 1u; }
+
+#endif
