@@ -1,5 +1,5 @@
-/* gs_dbits.h - tests of a double from its IEEE bits (private to the text and
- * bookkeeping files of the core). Where double is emulated (a Cortex-M4F) each
+/* gs_dbits.h - tests of a double from its IEEE bits (private to the core's
+ * files). Where double is emulated (a Cortex-M4F) each
  * isfinite/isnan/compare is a libgcc call; these are a few integer instructions
  * and give the same answers. */
 #ifndef GS_DBITS_H

@@ -6,7 +6,7 @@
 #include <string.h>
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
-#include "gs_dfinite.h"
+#include "gs_dbits.h"
 
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
@@ -42,8 +42,8 @@ void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
         return;
     }
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    fit_start(f, gs_double_finite(t0_s) ? t0_s : 0.0,
-              (gs_double_finite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0);
+    fit_start(f, gs_dfinite(t0_s) ? t0_s : 0.0,
+              (gs_dfinite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0);
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -102,7 +102,7 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
 
 void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
 {
-    if (!f || !(w > 0.0) || !isfinite(w) || !gs_double_finite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
+    if (!f || !(w > 0.0) || !isfinite(w) || !gs_dfinite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
         return;
     }
     add_row(f, fit_tau(t_s, f->t0_s, f->tscale_s), x_px, y_px, w);

@@ -24,6 +24,7 @@
  *    flights, in double they decide as on the host;
  *  - the event's public fields (double). */
 #include "gravscale/gs_flight.h"
+#include "gs_dbits.h"
 
 #include <math.h>
 #include <string.h>
@@ -78,13 +79,6 @@ static NOINLINE int64_t ceil_count(double x)
 /* isfinite of a gs_real (or float) value, in one place */
 static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
 
-/* isfinite of a double by its exponent bits: the same answer without soft-float compares */
-static bool finite_d(double x)
-{
-    uint64_t b;
-    memcpy(&b, &x, sizeof b);
-    return ((uint32_t)(b >> 52) & 0x7ffu) != 0x7ffu;
-}
 
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
@@ -103,7 +97,7 @@ static double t_at(const gs_flight *f, uint64_t i)
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px) && finite_d(s->t_s);
+    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px) && gs_dfinite(s->t_s);
 }
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
@@ -317,7 +311,7 @@ static NOINLINE gs_real cusum_step(gs_real S, gs_real z)
 /* typical frame interval from the history (for time-based spans) */
 static NOINLINE double frame_dt(const gs_flight *f)
 {
-    return (finite_d(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
+    return (gs_dfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
@@ -383,7 +377,7 @@ static NOINLINE uint64_t history_floor(const gs_flight *f)
 static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r)
 {
     double t_lo = t_at(f, lo), t_hi = t_at(f, hi);
-    if (!finite_d(t_lo) || !finite_d(t_hi) || hi <= lo) return false;
+    if (!gs_dfinite(t_lo) || !gs_dfinite(t_hi) || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, r) != GS_OK)
@@ -560,7 +554,7 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
     gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
     double t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
-    if (!finite_d(t_lo) || !finite_d(t_hi) || !finite_d(t_in) || !finite_d(t_out)) return NAN;
+    if (!gs_dfinite(t_lo) || !gs_dfinite(t_hi) || !gs_dfinite(t_in) || !gs_dfinite(t_out)) return NAN;
     double tc = 0.5 * (t_lo + t_hi), ts = 0.5 * (t_hi - t_lo);
     if (!(ts > 0.0)) return NAN;
     /* search between the outermost contact sample and a little inside the flight */
@@ -733,7 +727,7 @@ static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint
     gs_sample_full s_b;
     const gs_sample_full *s = at(f, i, &s_b);
     if (!s) return false;
-    if (!finite_d(T)) return side < 0 ? i >= edge : i <= edge;
+    if (!gs_dfinite(T)) return side < 0 ? i >= edge : i <= edge;
     return past_s(s->t_s, T, side) < 0.0;
 }
 
@@ -824,8 +818,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        if (!s || !(s->w > 0.0f) || !finite_d(s->t_s)) continue;  /* frames missing from the source */
-        if (finite_d(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
+        if (!s || !(s->w > 0.0f) || !gs_dfinite(s->t_s)) continue;  /* frames missing from the source */
+        if (gs_dfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
@@ -834,8 +828,8 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
     double half_dt = 0.5 * dt;
-    if (!finite_d(T0)) T0 = sf->t_s - half_dt;
-    if (!finite_d(T1)) T1 = sl->t_s + half_dt;
+    if (!gs_dfinite(T0)) T0 = sf->t_s - half_dt;
+    if (!gs_dfinite(T1)) T1 = sl->t_s + half_dt;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -956,7 +950,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     if (IS_RIGID(f) || !size_ok(s->size_px)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
     if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
-    if (!finite_d(f->still_since)) f->still_since = s->t_s;
+    if (!gs_dfinite(f->still_since)) f->still_since = s->t_s;
     if (s->upright >= LOOSE_UPRIGHT) {
         keep_size(f->loose_size, &f->loose_n, &f->loose_next, s->size_px);
     }
@@ -1052,7 +1046,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     update_standing(f, s, speed);
 
     /* recent minimum over two half-second blocks */
-    if (!finite_d(f->blk_t0)) f->blk_t0 = tm;
+    if (!gs_dfinite(f->blk_t0)) f->blk_t0 = tm;
     if (tm - f->blk_t0 > 0.5) {
         f->blk_min_prev = f->blk_min_cur;
         f->blk_min_cur = INFINITY;
@@ -1161,13 +1155,13 @@ void gs_flight_update(gs_flight *f)
         const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
-        bool present = s && s->w > 0.0f && finite_d(s->t_s);
+        bool present = s && s->w > 0.0f && gs_dfinite(s->t_s);
         if (present && !usable(s)) { f->last_t_s = s->t_s; continue; }
         if (!present) continue;
-        if (finite_d(f->last_t_s)) {
+        if (gs_dfinite(f->last_t_s)) {
             double dt = s->t_s - f->last_t_s;
             if (dt > GS_R(0.0)) {
-                if (!finite_d(f->dt_med_s)) f->dt_med_s = dt;
+                if (!gs_dfinite(f->dt_med_s)) f->dt_med_s = dt;
                 else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
             }
             if (dt > (double)f->cfg->max_gap_s) {

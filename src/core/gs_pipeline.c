@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "gs_dfinite.h"
+#include "gs_dbits.h"
 
 #define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~((size_t)(a) - 1u))
 
@@ -128,8 +128,8 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
 static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
 {
     if (p->finished) return GS_ESTATE;
-    if (!gs_double_finite(s->t_s)) return GS_EINVAL;
-    if (gs_double_finite(p->last_t_s)) {
+    if (!gs_dfinite(s->t_s)) return GS_EINVAL;
+    if (gs_dfinite(p->last_t_s)) {
         if (s->t_s < p->last_t_s) return GS_EORDER;
         if (s->t_s == p->last_t_s) return GS_OK;  /* a repeated frame carries nothing new */
     }

@@ -4,7 +4,7 @@
 
 #include <math.h>
 
-#include "gs_dfinite.h"
+#include "gs_dbits.h"
 
 #define SIZE_FINE_Q 0x8000u      /* codes below: 1/16 px steps */
 #define SIZE_FINE_PX 2048.0f     /* ... up to here, then 1/4 px steps */
@@ -33,11 +33,11 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
 
 int64_t gs_ring_time_us(const gs_ring *r, double t_s)
 {
-    if (!r || !gs_double_finite(t_s)) {
+    if (!r || !gs_dfinite(t_s)) {
         return INT64_MIN;
     }
     /* the first sample becomes the base; double because it is an absolute time */
-    double base = gs_double_finite(r->t_base_s) ? r->t_base_s : t_s;
+    double base = gs_dfinite(r->t_base_s) ? r->t_base_s : t_s;
     double us = (t_s - base) * 1e6;
     double mag_us = fabs(us);
     if (!(mag_us < TIME_MAX_US)) {
@@ -125,7 +125,7 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     if (us == INT64_MIN) {
         return GS_EINVAL;
     }
-    bool first = !gs_double_finite(r->t_base_s);
+    bool first = !gs_dfinite(r->t_base_s);
     if (!first && us < r->t_last_us) {
         return GS_EORDER;
     }
