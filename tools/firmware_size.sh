@@ -16,7 +16,10 @@
 #     | camera-coco17 | camera-blazepose33 (that skeleton layout, NMEA, parsed profile,
 #       no trace events, no ransac)
 #   GS_FW_FEATURES="GS_WITH_JSON=0 GS_WITH_BLAZEPOSE33=0"  features left out (overrides the device's)
-#   GS_FW_PROFILE=OFF  a compiled-in configuration instead of the parsed profile text
+#   GS_FW_PROFILE=OFF  the profile baked at build time (tools/fw/fw_bake.c: parsed and checked
+#     on the host, no text parser linked) instead of its text parsed at boot
+#   GS_FW_PROFILE_FILE=firmware_cfg/ball_lab.cfg  the firmware's profile (default
+#     tools/fw/workload.cfg, which the workload's ball and skeleton both pass)
 # e.g. GS_FW_DEVICE=ball-lab tools/firmware_size.sh build-m4-ball
 set -eu
 top=$(cd "$(dirname "$0")/.." && pwd)
@@ -44,16 +47,19 @@ case ${GS_FW_DEVICE:-all} in
 esac
 features=${GS_FW_FEATURES:-$dev_features}
 profile=${GS_FW_PROFILE:-$dev_profile}
+profile_file=${GS_FW_PROFILE_FILE:-$top/tools/fw/workload.cfg}
+case $profile_file in /*) ;; *) profile_file=$(pwd)/$profile_file ;; esac
 # the same selection for the host twin (cc -D...)
 twin_defs=""
 for f in $features; do twin_defs="$twin_defs -D$f"; done
-[ "$profile" = OFF ] && twin_defs="$twin_defs -DFW_NO_PROFILE=1"
-echo "--- device ${GS_FW_DEVICE:-all}: features off: ${features:-none}; profile parser: $profile"
+[ "$profile" = OFF ] && twin_defs="$twin_defs -DFW_PROFILE_BAKED=1"
+echo "--- device ${GS_FW_DEVICE:-all}: features off: ${features:-none}; profile $(basename "$profile_file") parsed at boot: $profile (OFF: baked)"
 # build_fw DIR LTO: configure and build the firmware in DIR
 build_fw() {
   if ! cmake -S "$top" -B "$1" $gen -DCMAKE_TOOLCHAIN_FILE="$top/cmake/cortex-m4.cmake" -DGS_FW_LTO=$2 \
        -DGS_BUILD_HOST=OFF -DGS_REAL=${GS_FW_REAL:-float} -DCMAKE_BUILD_TYPE=MinSizeRel \
-       -DGS_FEATURES="$(echo $features | tr ' ' ';')" -DGS_FW_PROFILE=$profile >"$1.configure.log" 2>&1; then
+       -DGS_FEATURES="$(echo $features | tr ' ' ';')" -DGS_FW_PROFILE=$profile \
+       -DGS_FW_PROFILE_FILE="$profile_file" >"$1.configure.log" 2>&1; then
     cat "$1.configure.log" >&2; echo "firmware_size: configure failed" >&2; exit 2
   fi
   rm -f "$1.configure.log"
@@ -168,7 +174,7 @@ if command -v qemu-system-arm >/dev/null 2>&1; then
     grep -v '^#' "$qout" >"$qout.lines" && mv "$qout.lines" "$qout"
     hcc=${CC_HOST:-cc}
     for r in "$real" double; do
-      "$hcc" -std=c11 -O2 -DGS_REAL=$r $twin_defs -I"$top/include" -I"$top/tools/fw" "$top"/src/core/*.c \
+      "$hcc" -std=c11 -O2 -DGS_REAL=$r $twin_defs -I"$top/include" -I"$top/tools/fw" -I"$bdir" "$top"/src/core/*.c \
         "$top/tools/fw/fw_scenario.c" "$top/tools/fw/fw_host.c" -lm -o "$bdir/fw_host_$r" &&
         "$bdir/fw_host_$r" >"$bdir/fw_host_$r.out" || { echo "FAIL host twin ($r) did not build or run"; fail=1; }
     done

@@ -1,7 +1,10 @@
 /* fw_scenario.c - the firmware's workload: the core on static memory (a
- * 512-sample ring), a profile parsed from flash, synthetic frames pushed one by
- * one, every event formatted into a line buffer. No heap, no stdio. */
+ * 512-sample ring), its profile (fw_profile.h, baked from tools/fw/workload.cfg
+ * by fw_bake.c: parsed from flash at boot, or with FW_PROFILE_BAKED the parsed
+ * configuration itself), synthetic frames pushed one by one, every event
+ * formatted into a line buffer. No heap, no stdio. */
 #include "fw_scenario.h"
+#include "fw_profile.h"
 
 #include <math.h>
 #include <string.h>
@@ -20,18 +23,16 @@ static char g_line[GS_EMIT_MAX];
 static fw_line_fn g_sink;
 static uint32_t g_status;
 
-static const char k_profile[] =
-    "[core]\n"
-    "fit = irls\n"
-    "ring_capacity = 512\n"
-    "size_min_m = 0.02\n"
-    "size_max_m = 2.5\n";
+#ifndef FW_PROFILE_BAKED
+static const char k_profile[] = FW_PROFILE_TEXT;
 
 static gs_status core_section(void *ctx, const char *key, size_t key_len, const char *value,
                               size_t value_len, char *msg, size_t cap)
 {
     return gs_core_config_set(ctx, key, key_len, value, value_len, msg, cap);
 }
+
+#endif
 
 static void on_event(void *ctx, const gs_event *ev)
 {
@@ -86,19 +87,16 @@ static void push_pose(double t, float y_off_px)
 
 uint32_t fw_scenario_run(bool pose, fw_line_fn line)
 {
+    g_sink = line;
+#ifndef FW_PROFILE_BAKED
     gs_cfg_error err;
     const gs_cfg_section sec = {"core", core_section, &g_cfg};
-    g_sink = line;
     gs_core_config_default(&g_cfg);
-#ifndef FW_NO_PROFILE
     g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
 #else
-    /* a compiled-in configuration: no text parser linked (measures its cost) */
-    (void)sec;
-    (void)err;
-    (void)k_profile;
-    g_cfg.size_min_m = 0.02f;
-    g_cfg.size_max_m = 2.5f;
+    /* checked at build time: no text parser linked */
+    static const gs_core_config k_baked = FW_PROFILE_CONFIG;
+    g_cfg = k_baked;
     g_status = 0;
 #endif
 #if GS_WITH_POSE
