@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The converted BlazePose models (tools/fetch_models.sh, tools/tflite_onnx.py).
 
-Runs in the venv .venv/ (re-executes itself there): each ONNX model is run by
+Runs in the venv .venv/ (GS_VENV; re-executes itself there), on models/ (GS_MODELS_DIR): each ONNX model is run by
 OpenCV 4.6's DNN module (Debian's python3-opencv, the same build as the C++
 library) and compared with the original TFLite model run by the TFLite
 interpreter (ai-edge-litert), on random inputs and on two real photos shipped
@@ -16,8 +16,10 @@ import os
 import sys
 
 TOP = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-VENV = os.path.join(TOP, ".venv")
-MODELS = os.path.join(TOP, "models")
+# GS_MODELS_DIR and GS_VENV point elsewhere (as for the programs: a worktree
+# sharing another checkout's fetched models)
+VENV = os.environ.get("GS_VENV") or os.path.join(TOP, ".venv")
+MODELS = os.environ.get("GS_MODELS_DIR") or os.path.join(TOP, "models")
 HINT = "run tools/fetch_models.sh (setup makes the venv and the models)"
 
 if os.path.realpath(sys.prefix) != os.path.realpath(VENV):
