@@ -4,8 +4,7 @@
  * starting with "#stem\n" is named stem_keypoints.json (stem cut to [A-Za-z0-9_]),
  * else <index>_keypoints.json. Same properties as fuzz_alphapose.c.
  * Built by tests/fuzz/run.sh (clang), not by CMake. */
-#include "gs_kpread.h"
-#include "fuzz_pipe.h"
+#include "fuzz_kpread.h"
 
 #include <dirent.h>
 #include <sys/stat.h>
@@ -83,38 +82,5 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         p = z + 1;
     }
 
-    gs_kpread_error err;
-    memset(&err, 0x5a, sizeof err);
-    gs_kpread *r = gs_kpread_open(g_dir, &o, &err);
-    if (!r) {
-        FZ_CHECK(err.status == GS_KPR_EDATA);
-        FZ_CHECK(memchr(err.text, 0, sizeof err.text) && memchr(err.field, 0, sizeof err.field));
-        FZ_CHECK(strncmp(err.text, g_dir, strlen(g_dir)) == 0);
-        return 0;
-    }
-    FZ_CHECK(gs_kpread_layout(r) == GS_LAYOUT_COCO17);
-    fz_pipe fp;
-    fz_pipe_begin(&fp, GS_LAYOUT_COCO17, sel >> 5);
-    gs_kpframe f;
-    bool first = true;
-    uint64_t last_frame = 0;
-    gs_kpr_status st;
-    while ((st = gs_kpread_next(r, &f, &err)) == GS_KPR_FRAME) {
-        FZ_CHECK(first || f.frame > last_frame);
-        first = false;
-        last_frame = f.frame;
-        FZ_CHECK(f.t_s == (double)f.frame / o.fps);
-        for (int k = 0; k < 17; k++) {
-            const gs_kp *kp = &f.kp[k];
-            FZ_CHECK(kp->c >= 0.0f && kp->c <= 1.0f);
-            FZ_CHECK(isnan(kp->x_px) || isfinite(kp->x_px));
-            FZ_CHECK(isnan(kp->y_px) || isfinite(kp->y_px));
-            if (kp->c == 0.0f) FZ_CHECK(isnan(kp->x_px) && isnan(kp->y_px)); /* OpenPose's 0,0,0 = not found */
-        }
-        fz_pipe_push(&fp, GS_LAYOUT_COCO17, f.kp, f.t_s, f.size_px);
-    }
-    FZ_CHECK(st == GS_KPR_EOF);
-    fz_pipe_end(&fp);
-    gs_kpread_close(r);
-    return 0;
+    return fz_json_reader_run(g_dir, &o, (uint8_t)(sel >> 5), true);
 }
