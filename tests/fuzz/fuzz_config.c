@@ -49,38 +49,3 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     free(s);
     return 0;
 }
-
-#ifdef GS_FUZZ_MAIN
-#include <stdio.h>
-int main(int argc, char **argv)
-{
-    static uint8_t buf[1 << 16];
-    for (int i = 1; i < argc; i++) {
-        FILE *f = fopen(argv[i], "rb");
-        if (!f) continue;
-        size_t n = fread(buf, 1, sizeof buf, f);
-        fclose(f);
-        LLVMFuzzerTestOneInput(buf, n);
-    }
-    if (argc > 1) return 0;
-    static const char seed[] = "[core]\ng_m_s2 = 9.81\nlatitude_deg = 45 # c\r\nfit = ransac\n[other]\nx = 1\n"
-                               "ring_capacity = 1024\n; end\n";
-    static const char alpha[] = "[]=#;\n\r \t.-0123456789eaxcore_\0";
-    uint64_t r = 88172645463325252ull;
-    for (int it = 0; it < 100000; it++) {
-        size_t n = sizeof seed - 1;
-        memcpy(buf, seed, n);
-        int muts = 1 + (int)(r % 6u);
-        for (int m = 0; m < muts; m++) {
-            r ^= r << 13; r ^= r >> 7; r ^= r << 17;
-            size_t pos = (size_t)(r % n);
-            r ^= r << 13; r ^= r >> 7; r ^= r << 17;
-            buf[pos] = (uint8_t)alpha[r % (sizeof alpha - 1)];
-        }
-        r ^= r << 13; r ^= r >> 7; r ^= r << 17;
-        LLVMFuzzerTestOneInput(buf, (size_t)(r % (n + 1)));
-    }
-    puts("fuzz_config: 100000 mutated inputs ok");
-    return 0;
-}
-#endif

@@ -56,33 +56,3 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     free(s);
     return 0;
 }
-
-#ifdef GS_FUZZ_MAIN
-#include <stdio.h>
-int main(int argc, char **argv)
-{
-    static uint8_t buf[1 << 16];
-    for (int i = 1; i < argc; i++) {
-        FILE *f = fopen(argv[i], "rb");
-        if (!f) continue;
-        size_t n = fread(buf, 1, sizeof buf, f);
-        fclose(f);
-        LLVMFuzzerTestOneInput(buf, n);
-    }
-    if (argc > 1) return 0;
-    static const char alpha[] = "0123456789.eE+-0123456789 x";
-    uint64_t r = 88172645463325252ull;
-    for (int it = 0; it < 200000; it++) {
-        size_t n = 0;
-        size_t len = (size_t)(r % 40u);
-        for (; n < len; n++) {
-            r ^= r << 13; r ^= r >> 7; r ^= r << 17;
-            buf[n] = (uint8_t)alpha[r % (sizeof alpha - 1)];
-        }
-        r ^= r << 13; r ^= r >> 7; r ^= r << 17;
-        LLVMFuzzerTestOneInput(buf, n);
-    }
-    puts("fuzz_num: 200000 random inputs ok");
-    return 0;
-}
-#endif
