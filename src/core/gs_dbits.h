@@ -33,4 +33,8 @@ static inline bool gs_disnan(double x) { return gs_dbits_abs(x) > GS_DBITS_INF; 
 /* finite and > 0 (not +-0, not NaN) */
 static inline bool gs_dpositive(double x) { return gs_dbits(x) - 1u < GS_DBITS_INF - 1u; }
 
+/* trunc(|x|) for |x| < 2^64 (finite), exact, without libgcc's double-to-integer routines.
+ * One copy, in gs_ring.c (the ring's time conversion; the flight's frame counts use it too). */
+uint64_t gs_dtrunc_abs(double x);
+
 #endif

@@ -42,10 +42,12 @@
 #define NOINLINE __attribute__((noinline))
 
 /* ceil(x) as an integer, without libm, for frame counts (finite |x| < 2^62; they are
- * far below). One 64-bit conversion for all of them (the ring links it anyway). */
+ * far below). Truncated from the bits; (double)t is exact and costs nothing (libgcc's
+ * int-to-double conversions come with its double add), */
 static NOINLINE int64_t ceil_count(double x)
 {
-    int64_t t = (int64_t)x;  /* toward zero, exact */
+    int64_t m = (int64_t)gs_dtrunc_abs(x);
+    int64_t t = (gs_dbits(x) & GS_DBITS_SIGN) ? -m : m; /* toward zero, exact */
     return (double)t < x ? t + 1 : t;
 }
 

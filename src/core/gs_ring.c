@@ -31,6 +31,15 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
     return GS_OK;
 }
 
+__attribute__((noinline)) uint64_t gs_dtrunc_abs(double x)
+{
+    uint64_t b = gs_dbits_abs(x);
+    uint32_t ex = (uint32_t)(b >> 52); /* biased: |x| = 1.f 2^(ex - 1023) */
+    if (ex < 1023u) return 0u;         /* |x| < 1 */
+    /* the mantissa with its hidden bit at the top, shifted down by the exponent */
+    return ((b << 11) | GS_DBITS_SIGN) >> (1086u - ex);
+}
+
 int64_t gs_ring_time_us(const gs_ring *r, double t_s)
 {
     if (!r || !gs_dfinite(t_s)) {
@@ -44,7 +53,7 @@ int64_t gs_ring_time_us(const gs_ring *r, double t_s)
         return INT64_MIN;
     }
     /* round half away from zero without libm's llround: the magnitude, then the sign */
-    int64_t n = (int64_t)(mag_us + 0.5);
+    int64_t n = (int64_t)gs_dtrunc_abs(mag_us + 0.5);
     return signbit(us) ? -n : n;
 }
 
