@@ -31,15 +31,6 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
     return GS_OK;
 }
 
-__attribute__((noinline)) uint64_t gs_dtrunc_abs(double x)
-{
-    uint64_t b = gs_dbits_abs(x);
-    uint32_t ex = (uint32_t)(b >> 52); /* biased: |x| = 1.f 2^(ex - 1023) */
-    if (ex < 1023u) return 0u;         /* |x| < 1 */
-    /* the mantissa with its hidden bit at the top, shifted down by the exponent */
-    return ((b << 11) | GS_DBITS_SIGN) >> (1086u - ex);
-}
-
 int64_t gs_ring_time_us(const gs_ring *r, double t_s)
 {
     if (!r || !gs_dfinite(t_s)) {
@@ -49,7 +40,7 @@ int64_t gs_ring_time_us(const gs_ring *r, double t_s)
     double base = gs_dfinite(r->t_base_s) ? r->t_base_s : t_s;
     double us = (t_s - base) * 1e6;
     double mag_us = fabs(us);
-    if (!(mag_us < TIME_MAX_US)) {
+    if (!gs_dlt(mag_us, TIME_MAX_US)) {
         return INT64_MIN;
     }
     /* round half away from zero without libm's llround: the magnitude, then the sign */
