@@ -42,8 +42,8 @@
 #define NOINLINE __attribute__((noinline))
 
 /* ceil(x) as an integer, without libm, for frame counts (finite |x| < 2^62; they are
- * far below). Truncated from the bits; (double)t is exact and costs nothing (libgcc's
- * int-to-double conversions come with its double add), */
+ * far below). Truncated from the bits (gs_dbits.c); (double)t is exact and links nothing
+ * new (libgcc's int-to-double conversions sit in its double add's object). */
 static NOINLINE int64_t ceil_count(double x)
 {
     int64_t m = (int64_t)gs_dtrunc_abs(x);
