@@ -338,7 +338,7 @@ static bool dbl_ok(const num_key *k, double x, bool as_float)
         lo = (double)(float)lo;
         hi = (double)(float)hi;
     }
-    return x >= lo && x <= hi;
+    return gs_dge(x, lo) && gs_dle(x, hi);
 }
 
 static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, size_t n, char *msg, size_t cap)

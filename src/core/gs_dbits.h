@@ -33,4 +33,27 @@ static inline bool gs_disnan(double x) { return gs_dbits_abs(x) > GS_DBITS_INF; 
 /* finite and > 0 (not +-0, not NaN) */
 static inline bool gs_dpositive(double x) { return gs_dbits(x) - 1u < GS_DBITS_INF - 1u; }
 
+/* ---- in gs_dbits.c: one copy each of what libgcc's double routines did ---- */
+
+/* Where doubles are passed in FPU registers (hard-float ARM) but computed in core
+ * registers (soft double on a single-precision FPU), these take them in core registers
+ * as libgcc's routines do: no moves at the call sites. */
+#if defined(__arm__) && defined(__ARM_PCS_VFP)
+#define GS_DBITS_PCS __attribute__((pcs("aapcs")))
+#else
+#define GS_DBITS_PCS
+#endif
+
+/* trunc(|x|) for |x| < 2^64 (finite), exact, without libgcc's double-to-integer routines */
+GS_DBITS_PCS uint64_t gs_dtrunc_abs(double x);
+
+/* IEEE's order of a and b from the bits: -1 (a < b), 0 (equal; -0 == +0), 1 (a > b), or
+ * 2 (unordered: a NaN). Where double is emulated each compare is otherwise a libgcc call,
+ * and any of them links its whole compare routine. */
+GS_DBITS_PCS int gs_dcmp(double a, double b);
+static inline bool gs_dlt(double a, double b) { return gs_dcmp(a, b) < 0; }
+static inline bool gs_dle(double a, double b) { return gs_dcmp(a, b) <= 0; }
+static inline bool gs_dgt(double a, double b) { return gs_dcmp(a, b) == 1; }
+static inline bool gs_dge(double a, double b) { return (unsigned)gs_dcmp(a, b) <= 1u; }
+
 #endif

@@ -43,7 +43,7 @@ void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
     }
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
     fit_start(f, gs_dfinite(t0_s) ? t0_s : 0.0,
-              (gs_dfinite(tscale_s) && tscale_s > 0.0) ? tscale_s : 1.0);
+              gs_dpositive(tscale_s) ? tscale_s : 1.0);
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -646,7 +646,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
             m++;
         }
     }
-    if (m < 3 || !(t_max > t_min)) {
+    if (m < 3 || !gs_dgt(t_max, t_min)) {
         return GS_EINVAL;
     }
     wn->ring = ring;

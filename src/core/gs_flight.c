@@ -42,11 +42,13 @@
 #define NOINLINE __attribute__((noinline))
 
 /* ceil(x) as an integer, without libm, for frame counts (finite |x| < 2^62; they are
- * far below). One 64-bit conversion for all of them (the ring links it anyway). */
+ * far below). Truncated from the bits (gs_dbits.c); (double)t is exact and links nothing
+ * new (libgcc's int-to-double conversions sit in its double add's object). */
 static NOINLINE int64_t ceil_count(double x)
 {
-    int64_t t = (int64_t)x;  /* toward zero, exact */
-    return (double)t < x ? t + 1 : t;
+    int64_t m = (int64_t)gs_dtrunc_abs(x);
+    int64_t t = (gs_dbits(x) & GS_DBITS_SIGN) ? -m : m; /* toward zero, exact */
+    return gs_dlt((double)t, x) ? t + 1 : t;
 }
 
 /* tuning: thresholds in units of the noise or of the object's size */
@@ -105,7 +107,7 @@ static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i)
 /* t1 - t0 longer than a configured span (false when either time is NaN) */
 static NOINLINE bool span_over(double t1, double t0, float span_s)
 {
-    return t1 - t0 > (double)span_s;
+    return gs_dgt(t1 - t0, (double)span_s);
 }
 
 /* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side.
@@ -311,7 +313,7 @@ static NOINLINE gs_real cusum_step(gs_real S, gs_real z)
 /* typical frame interval from the history (for time-based spans) */
 static NOINLINE double frame_dt(const gs_flight *f)
 {
-    return (gs_dfinite(f->dt_med_s) && f->dt_med_s > 0.0) ? f->dt_med_s : 1.0 / 30.0;
+    return gs_dpositive(f->dt_med_s) ? f->dt_med_s : 1.0 / 30.0;
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
@@ -383,7 +385,7 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r
     if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, r) != GS_OK)
         return false;
     double tspan = t_hi - t_lo;
-    gs_fit_init(&f->fit, 0.5 * (t_lo + t_hi), tspan > 0.0 ? tspan : frame_dt(f));
+    gs_fit_init(&f->fit, 0.5 * (t_lo + t_hi), gs_dgt(tspan, 0.0) ? tspan : frame_dt(f));
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = usable_at(f, i, &s_b);
@@ -556,10 +558,10 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
     double t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
     if (!gs_dfinite(t_lo) || !gs_dfinite(t_hi) || !gs_dfinite(t_in) || !gs_dfinite(t_out)) return NAN;
     double tc = 0.5 * (t_lo + t_hi), ts = 0.5 * (t_hi - t_lo);
-    if (!(ts > 0.0)) return NAN;
+    if (!gs_dgt(ts, 0.0)) return NAN;
     /* search between the outermost contact sample and a little inside the flight */
     double dt = frame_dt(f);
-    double inside = BOUNDARY_IN_S > dt ? BOUNDARY_IN_S : dt;
+    double inside = gs_dgt(BOUNDARY_IN_S, dt) ? BOUNDARY_IN_S : dt;
     double t_edge = t_in + (side < 0 ? inside : -inside);
     double t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
     int64_t n_steps = ceil_count((t_to - t_from) / dt * BOUNDARY_STEPS);
@@ -570,7 +572,7 @@ static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int 
         double T = t_from + (t_to - t_from) * (double)k / (double)steps;
         gs_real ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
         /* dropping samples the online test took as flight must pay for itself */
-        if (past_s(T, t_in, side) < 0.0) ssr += penalty;
+        if (gs_dlt(past_s(T, t_in, side), 0.0)) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
@@ -728,7 +730,7 @@ static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint
     const gs_sample_full *s = at(f, i, &s_b);
     if (!s) return false;
     if (!gs_dfinite(T)) return side < 0 ? i >= edge : i <= edge;
-    return past_s(s->t_s, T, side) < 0.0;
+    return gs_dlt(past_s(s->t_s, T, side), 0.0);
 }
 
 /* The flight's outermost sample on one side: from `from` step toward `to` (inward)
@@ -819,7 +821,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s || !(s->w > 0.0f) || !gs_dfinite(s->t_s)) continue;  /* frames missing from the source */
-        if (gs_dfinite(t_prev) && s->t_s - t_prev > max_gap_in) max_gap_in = s->t_s - t_prev;
+        if (gs_dfinite(t_prev) && gs_dgt(s->t_s - t_prev, max_gap_in)) max_gap_in = s->t_s - t_prev;
         t_prev = s->t_s;
         if (!usable(s)) continue;
         n_in++;
@@ -877,7 +879,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 
         if (n_in < f->cfg->min_samples || (gs_real)j->flight_time_s < (gs_real)f->cfg->min_flight_s)
             j->reason = GS_REJ_FEW_SAMPLES;
-        else if (max_gap_in > (double)f->cfg->max_gap_s)
+        else if (gs_dgt(max_gap_in, (double)f->cfg->max_gap_s))
             j->reason = GS_REJ_GAP;
         else if (!finite_r(size))
             j->reason = GS_REJ_NO_SIZE;
@@ -932,7 +934,7 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
     const gs_sample_full *b = usable_at(f, idx - k, &b_b);
-    if (!b || !(s->t_s > b->t_s)) return NAN;
+    if (!b || !gs_dgt(s->t_s, b->t_s)) return NAN;
     return GS_FABSR(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
 }
 
@@ -955,7 +957,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
         keep_size(f->loose_size, &f->loose_n, &f->loose_next, s->size_px);
     }
     if (!(s->upright >= STAND_UPRIGHT)) return;
-    if (s->t_s - f->still_since < STAND_SETTLE_S) return;  /* settled, not rising onto the toes */
+    if (gs_dlt(s->t_s - f->still_since, STAND_SETTLE_S)) return;  /* settled, not rising onto the toes */
     keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_t = s->t_s;
     /* body axis -> image up, until flights measure gravity directly */
@@ -978,7 +980,7 @@ static float last_stand_size(const gs_flight *f)
 double gs_flight_stand_at(const gs_flight *f, double t_s)
 {
     /* the ring gives times back to the microsecond: same frame within half a millisecond */
-    if (!f || f->stand_n == 0 || !(fabs(f->stand_last_t - t_s) < 5e-4)) return NAN;
+    if (!f || f->stand_n == 0 || !gs_dlt(fabs(f->stand_last_t - t_s), 5e-4)) return NAN;
     return (gs_real)last_stand_size(f);
 }
 
@@ -1047,7 +1049,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 
     /* recent minimum over two half-second blocks */
     if (!gs_dfinite(f->blk_t0)) f->blk_t0 = tm;
-    if (tm - f->blk_t0 > 0.5) {
+    if (gs_dgt(tm - f->blk_t0, 0.5)) {
         f->blk_min_prev = f->blk_min_cur;
         f->blk_min_cur = INFINITY;
         f->blk_t0 = tm;
@@ -1160,11 +1162,11 @@ void gs_flight_update(gs_flight *f)
         if (!present) continue;
         if (gs_dfinite(f->last_t_s)) {
             double dt = s->t_s - f->last_t_s;
-            if (dt > GS_R(0.0)) {
+            if (gs_dgt(dt, 0.0)) {
                 if (!gs_dfinite(f->dt_med_s)) f->dt_med_s = dt;
-                else if (dt < 3.0 * f->dt_med_s) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
+                else if (gs_dlt(dt, 3.0 * f->dt_med_s)) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
             }
-            if (dt > (double)f->cfg->max_gap_s) {
+            if (gs_dgt(dt, (double)f->cfg->max_gap_s)) {
                 if (f->state == GS_FS_AIRBORNE) {
                     close_candidate(f, f->last_idx, UINT64_MAX, true);
                 }

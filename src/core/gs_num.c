@@ -309,7 +309,7 @@ static bool scale_pow10(uint64_t m, int e10, bool neg, double *out)
     bool down = e10 < 0;
     int k = down ? -e10 : e10;
     /* 10^22 at a time; an underflow to 0 stays 0 (and 0 / 10^k is 0) */
-    for (; k > 22 && r != 0.0; k -= 22) r = down ? r / 1e22 : r * 1e22;
+    for (; k > 22 && gs_dbits_abs(r) != 0u; k -= 22) r = down ? r / 1e22 : r * 1e22;
     double p = pow10_exact(k);
     r = down ? r / p : r * p;
     if (!gs_dfinite(r)) return false;

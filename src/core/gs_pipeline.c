@@ -130,8 +130,9 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
     if (p->finished) return GS_ESTATE;
     if (!gs_dfinite(s->t_s)) return GS_EINVAL;
     if (gs_dfinite(p->last_t_s)) {
-        if (s->t_s < p->last_t_s) return GS_EORDER;
-        if (s->t_s == p->last_t_s) return GS_OK;  /* a repeated frame carries nothing new */
+        int order = gs_dcmp(s->t_s, p->last_t_s);  /* both finite: -1, 0 or 1 */
+        if (order < 0) return GS_EORDER;
+        if (order == 0) return GS_OK;  /* a repeated frame carries nothing new */
     }
     int64_t us = gs_ring_time_us(&p->ring, s->t_s);
     if (us == INT64_MIN) return GS_ERANGE;

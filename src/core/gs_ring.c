@@ -40,11 +40,11 @@ int64_t gs_ring_time_us(const gs_ring *r, double t_s)
     double base = gs_dfinite(r->t_base_s) ? r->t_base_s : t_s;
     double us = (t_s - base) * 1e6;
     double mag_us = fabs(us);
-    if (!(mag_us < TIME_MAX_US)) {
+    if (!gs_dlt(mag_us, TIME_MAX_US)) {
         return INT64_MIN;
     }
     /* round half away from zero without libm's llround: the magnitude, then the sign */
-    int64_t n = (int64_t)(mag_us + 0.5);
+    int64_t n = (int64_t)gs_dtrunc_abs(mag_us + 0.5);
     return signbit(us) ? -n : n;
 }
 

@@ -22,7 +22,7 @@ void gs_session_init(gs_session *s, double absence_s, double new_body_rel)
     memset(s, 0, sizeof *s);
     s->absence_s = absence_s;
     s->new_body_rel = new_body_rel;
-    s->gap_s = absence_s < 0.5 ? absence_s : 0.5;
+    s->gap_s = gs_dlt(absence_s, 0.5) ? absence_s : 0.5;
     s->t_start_s = s->t_seen_s = NAN;
     reset_visit(s);
 }
@@ -58,14 +58,14 @@ uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_
     if (!s || !gs_dfinite(t_s)) return 0;
     if (end_reason) *end_reason = NULL;
     if (!present) {
-        if (s->open && t_s - s->t_seen_s >= s->absence_s) {
+        if (s->open && gs_dge(t_s - s->t_seen_s, s->absence_s)) {
             if (end_reason) *end_reason = "absence";
             return GS_SESSION_ENDED;  /* the caller emits the end, then gs_session_close */
         }
         return 0;
     }
     if (!s->open) return start(s, t_s);
-    if (t_s - s->t_seen_s >= s->gap_s && s->ref_n >= GS_SESSION_REF_N) s->gap_since_ref = true;
+    if (gs_dge(t_s - s->t_seen_s, s->gap_s) && s->ref_n >= GS_SESSION_REF_N) s->gap_since_ref = true;
     s->t_seen_s = t_s;
     if (!gs_dpositive(stand_px)) return 0;
     if (s->ref_n < GS_SESSION_REF_N) {
@@ -74,7 +74,7 @@ uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_
         return 0;
     }
     /* the same person stepping closer changes size while seen; someone else appears after a gap */
-    if (s->gap_since_ref && fabs(stand_px / s->ref_px - 1.0) > s->new_body_rel) {
+    if (s->gap_since_ref && gs_dgt(fabs(stand_px / s->ref_px - 1.0), s->new_body_rel)) {
         if (++s->odd_run >= ODD_RUN_NEEDED) {
             if (end_reason) *end_reason = "new_body";
             return GS_SESSION_ENDED;
@@ -91,7 +91,7 @@ static void tally(double x, double *sum, uint32_t *n, double *best)
     if (!gs_dfinite(x)) return;
     *sum += x;
     ++*n;
-    if (best && !(x <= *best)) *best = x; /* NaN best: the first */
+    if (best && !gs_dle(x, *best)) *best = x; /* NaN best: the first */
 }
 
 void gs_session_jump(gs_session *s, const gs_ev_jump *j)
