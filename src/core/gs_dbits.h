@@ -51,9 +51,18 @@ GS_DBITS_PCS uint64_t gs_dtrunc_abs(double x);
  * 2 (unordered: a NaN). Where double is emulated each compare is otherwise a libgcc call,
  * and any of them links its whole compare routine. */
 GS_DBITS_PCS int gs_dcmp(double a, double b);
-static inline bool gs_dlt(double a, double b) { return gs_dcmp(a, b) < 0; }
-static inline bool gs_dle(double a, double b) { return gs_dcmp(a, b) <= 0; }
-static inline bool gs_dgt(double a, double b) { return gs_dcmp(a, b) == 1; }
-static inline bool gs_dge(double a, double b) { return (unsigned)gs_dcmp(a, b) <= 1u; }
+
+/* The compares of the core: through gs_dcmp where double is emulated (an ARM FPU
+ * without double precision: __ARM_FP lacks bit 3), the plain operators where it is
+ * native (hosts: one instruction, the same answers; tests/test_dbits.c checks both). */
+#if defined(__arm__) && (!defined(__ARM_FP) || !(__ARM_FP & 8))
+#define GS_DBITS_SOFT 1
+#else
+#define GS_DBITS_SOFT 0
+#endif
+static inline bool gs_dlt(double a, double b) { return GS_DBITS_SOFT ? gs_dcmp(a, b) < 0 : a < b; }
+static inline bool gs_dle(double a, double b) { return GS_DBITS_SOFT ? gs_dcmp(a, b) <= 0 : a <= b; }
+static inline bool gs_dgt(double a, double b) { return GS_DBITS_SOFT ? gs_dcmp(a, b) == 1 : a > b; }
+static inline bool gs_dge(double a, double b) { return GS_DBITS_SOFT ? (unsigned)gs_dcmp(a, b) <= 1u : a >= b; }
 
 #endif
