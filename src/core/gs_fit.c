@@ -260,7 +260,8 @@ typedef struct {
 /* A held sample with a weight and a position takes part in the fits. */
 static bool sample_usable(const gs_sample *s)
 {
-    return gs_sample_w(s) > 0.0f && isfinite(s->x_px) && isfinite(s->y_px);
+    /* w_q > 0 is gs_sample_w(s) > 0 without the division */
+    return s->w_q > 0u && isfinite(s->x_px) && isfinite(s->y_px);
 }
 
 /* Window sample i unpacked into *out when it is held and usable; false otherwise. */
