@@ -15,7 +15,6 @@
 //  frames, same program) for q and the stature.
 #include <algorithm>
 #include <cmath>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

@@ -1,10 +1,8 @@
-/* app_common.c - option splitting, usage errors and config files for the commands. */
+/* app_common.c - option splitting and usage errors for the commands. */
 #include "app_common.h"
 
-#include <errno.h>
 #include <stdbool.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 int gs_app_usage_error(const char *cmd, const char *fmt, const char *arg)
@@ -41,41 +39,4 @@ int gs_app_option(const char *cmd, int argc, char **argv, int *i, const char *co
         *val = argv[++*i];
     }
     return -1;
-}
-
-void gs_app_print_cfg_error(const char *path, const gs_cfg_error *e)
-{
-    fprintf(stderr, "gravscale: %s:", path);
-    if (e->line > 0)
-        fprintf(stderr, "%u:", (unsigned)e->line);
-    if (e->section[0])
-        fprintf(stderr, " [%s]", e->section);
-    if (e->key[0])
-        fprintf(stderr, " key '%s'", e->key);
-    fprintf(stderr, "%s %s\n", (e->section[0] || e->key[0]) ? ":" : "",
-            e->msg[0] ? e->msg : "invalid configuration");
-}
-
-char *gs_app_read_config(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "gravscale: %s: cannot open config: %s\n", path, strerror(errno));
-        return NULL;
-    }
-    char *text = malloc(GS_APP_CONFIG_MAX_BYTES + 1); /* one byte more tells a file that is too large */
-    *n = text ? fread(text, 1, GS_APP_CONFIG_MAX_BYTES + 1, f) : 0;
-    bool bad = !text || ferror(f);
-    fclose(f);
-    if (bad) {
-        fprintf(stderr, "gravscale: %s: cannot read config\n", path);
-    } else if (*n > GS_APP_CONFIG_MAX_BYTES) {
-        fprintf(stderr, "gravscale: %s: config larger than %u bytes\n", path, (unsigned)GS_APP_CONFIG_MAX_BYTES);
-        bad = true;
-    }
-    if (bad) {
-        free(text);
-        return NULL;
-    }
-    return text;
 }

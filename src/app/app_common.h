@@ -1,11 +1,10 @@
 /* app_common.h - what the gravscale commands (replay, video, cam) share: the
- * exit codes, option splitting, the usage error line and the config file. */
+ * exit codes, option splitting and the usage error line (the config file:
+ * gs_profile.h). */
 #ifndef GS_APP_COMMON_H
 #define GS_APP_COMMON_H
 
 #include <stddef.h>
-
-#include "gravscale/gs_config.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -13,9 +12,6 @@ extern "C" {
 
 /* Exit codes of every command (README): 1 is bad input data (cam: the source failed). */
 enum { GS_EXIT_OK = 0, GS_EXIT_DATA = 1, GS_EXIT_USAGE = 2, GS_EXIT_IO = 3 };
-
-/* A config file is read whole; larger ones are refused. */
-#define GS_APP_CONFIG_MAX_BYTES (1u << 20)
 
 /* "gravscale: CMD: <fmt with arg> (see gravscale CMD --help)" on stderr; returns GS_EXIT_USAGE. */
 int gs_app_usage_error(const char *cmd, const char *fmt, const char *arg);
@@ -26,13 +22,6 @@ int gs_app_usage_error(const char *cmd, const char *fmt, const char *arg);
  * after the usage error line (unknown option, missing value). */
 int gs_app_option(const char *cmd, int argc, char **argv, int *i, const char *const *known, size_t n_known,
                   char *name, size_t name_cap, const char **val);
-
-/* "gravscale: PATH:LINE: [section] key 'k': message" on stderr. */
-void gs_app_print_cfg_error(const char *path, const gs_cfg_error *e);
-
-/* The whole file at path in a new buffer (free it), its length in *n; NULL after
- * an error line on stderr (cannot open, cannot read, larger than the limit). */
-char *gs_app_read_config(const char *path, size_t *n);
 
 #ifdef __cplusplus
 }

@@ -267,21 +267,21 @@ gs_status parse_profile(const std::string &text, Profile &p, bool small_object, 
 int load_profile(const Options &o, Profile &p)
 {
     size_t n = 0;
-    char *raw = gs_app_read_config(o.config.c_str(), &n);
+    char *raw = gs_profile_read("gravscale", o.config.c_str(), &n);
     if (!raw) return EXIT_USAGE;
     std::string text(raw, n);
     std::free(raw);
     gs_cfg_error e;
     // first pass: which detector (it sets the default size range), and every error
     if (parse_profile(text, p, false, e) != GS_OK) {
-        gs_app_print_cfg_error(o.config.c_str(), &e);
+        gs_profile_print_error("gravscale", o.config.c_str(), &e);
         return EXIT_USAGE;
     }
     const std::string det = o.detector.empty() ? p.cam.detector : o.detector;
     const std::string backend = o.backend.empty() ? p.cam.cap.backend : o.backend;
     // keypoints come without a detector: the size range stays a person's
     if (backend != "keypoints" && gs::detector_is_small_object(det) && parse_profile(text, p, true, e) != GS_OK) {
-        gs_app_print_cfg_error(o.config.c_str(), &e);
+        gs_profile_print_error("gravscale", o.config.c_str(), &e);
         return EXIT_USAGE;
     }
     // the command line wins

@@ -183,7 +183,7 @@ static int load_config(const char *path, gs_core_config *cfg)
     if (!path)
         return EXIT_OK;
     size_t n;
-    char *text = gs_app_read_config(path, &n);
+    char *text = gs_profile_read("gravscale", path, &n);
     if (!text)
         return EXIT_USAGE;
     /* [core]; the other sections of a profile belong to video and cam (gs_profile.h) */
@@ -200,7 +200,7 @@ static int load_config(const char *path, gs_core_config *cfg)
         st = gs_core_config_check(cfg, &e);
     }
     if (st != GS_OK) {
-        gs_app_print_cfg_error(path, &e);
+        gs_profile_print_error("gravscale", path, &e);
         return EXIT_USAGE;
     }
     return EXIT_OK;

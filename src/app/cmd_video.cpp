@@ -185,7 +185,7 @@ int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::B
     }
     if (path.empty()) return EXIT_OK;
     size_t n = 0;
-    std::unique_ptr<char, decltype(&std::free)> text(gs_app_read_config(path.c_str(), &n), &std::free);
+    std::unique_ptr<char, decltype(&std::free)> text(gs_profile_read("gravscale", path.c_str(), &n), &std::free);
     if (!text) return EXIT_USAGE;
     // [core], [ball] and [pose]; the other sections of a profile belong to cam (gs_profile.h)
     gs_cfg_section sections[3 + GS_PROFILE_SECTIONS] = {{"core", gs_core_config_set, &cfg},
@@ -206,7 +206,7 @@ int load_config(const std::string &path, bool person, gs_core_config &cfg, gs::B
         if (st != GS_OK) std::snprintf(e.section, sizeof e.section, "ball");
     }
     if (st != GS_OK) {
-        gs_app_print_cfg_error(path.c_str(), &e);
+        gs_profile_print_error("gravscale", path.c_str(), &e);
         return EXIT_USAGE;
     }
     return EXIT_OK;

@@ -1,6 +1,10 @@
 /* gs_profile.c - the sections of a profile that a program leaves to others. */
 #include "gs_profile.h"
 
+#include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char *const k_all[GS_PROFILE_SECTIONS] = {
@@ -31,4 +35,41 @@ size_t gs_profile_foreign_sections(const char *const *own, size_t n_own, gs_cfg_
         n++;
     }
     return n;
+}
+
+char *gs_profile_read(const char *prog, const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "%s: %s: cannot open config: %s\n", prog, path, strerror(errno));
+        return NULL;
+    }
+    char *text = malloc(GS_PROFILE_MAX_BYTES + 1); /* one byte more tells a file that is too large */
+    *n = text ? fread(text, 1, GS_PROFILE_MAX_BYTES + 1, f) : 0;
+    bool bad = !text || ferror(f);
+    fclose(f);
+    if (bad) {
+        fprintf(stderr, "%s: %s: cannot read config\n", prog, path);
+    } else if (*n > GS_PROFILE_MAX_BYTES) {
+        fprintf(stderr, "%s: %s: config larger than %u bytes\n", prog, path, (unsigned)GS_PROFILE_MAX_BYTES);
+        bad = true;
+    }
+    if (bad) {
+        free(text);
+        return NULL;
+    }
+    return text;
+}
+
+void gs_profile_print_error(const char *prog, const char *path, const gs_cfg_error *e)
+{
+    fprintf(stderr, "%s: %s:", prog, path);
+    if (e->line > 0)
+        fprintf(stderr, "%u:", (unsigned)e->line);
+    if (e->section[0])
+        fprintf(stderr, " [%s]", e->section);
+    if (e->key[0])
+        fprintf(stderr, " key '%s'", e->key);
+    fprintf(stderr, "%s %s\n", (e->section[0] || e->key[0]) ? ":" : "",
+            e->msg[0] ? e->msg : "invalid configuration");
 }

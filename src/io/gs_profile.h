@@ -19,4 +19,14 @@ size_t gs_profile_foreign_sections(const char *const *own, size_t n_own, gs_cfg_
 gs_status gs_profile_skip_key(void *ctx, const char *key, size_t key_len, const char *value,
                               size_t value_len, char *msg, size_t cap);
 
+/* A profile is read whole; larger ones are refused. */
+#define GS_PROFILE_MAX_BYTES (1u << 20)
+
+/* The whole file at path in a new buffer (free it), its length in *n; NULL after
+ * an error line "PROG: PATH: ..." on stderr (cannot open, cannot read, too large). */
+char *gs_profile_read(const char *prog, const char *path, size_t *n);
+
+/* "PROG: PATH:LINE: [section] key 'k': message" on stderr. */
+void gs_profile_print_error(const char *prog, const char *path, const gs_cfg_error *e);
+
 #endif

@@ -16,12 +16,11 @@
 #include "gravscale/gravscale.h"
 #include "gs_profile.h"
 
-#define PROFILE_MAX_BYTES (1u << 16)
 
 /* the [core] lines as the parser saw them, for FW_PROFILE_TEXT */
 typedef struct {
     gs_core_config *cfg;
-    char text[PROFILE_MAX_BYTES];
+    char text[1u << 16];
     size_t len;
 } core_ctx;
 
@@ -40,15 +39,6 @@ static gs_status core_key(void *ctx, const char *key, size_t key_len, const char
         c->len += (size_t)n;
     }
     return st;
-}
-
-static void print_error(const char *path, const gs_cfg_error *e)
-{
-    fprintf(stderr, "fw_bake: %s:", path);
-    if (e->line > 0) fprintf(stderr, "%u:", (unsigned)e->line);
-    if (e->section[0]) fprintf(stderr, " [%s]", e->section);
-    if (e->key[0]) fprintf(stderr, " key '%s'", e->key);
-    fprintf(stderr, "%s %s\n", (e->section[0] || e->key[0]) ? ":" : "", e->msg[0] ? e->msg : "invalid profile");
 }
 
 /* a C literal that reads back as exactly v (hex float; NAN for unknown) */
@@ -121,19 +111,10 @@ int main(int argc, char **argv)
         return argc == 2 && strcmp(argv[1], "--help") == 0 ? 0 : 2;
     }
     const char *path = argv[1], *out = argv[2];
-    static char text[PROFILE_MAX_BYTES + 1];
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "fw_bake: %s: cannot open: %s\n", path, strerror(errno));
+    size_t n;
+    char *text = gs_profile_read("fw_bake", path, &n);
+    if (!text)
         return 2;
-    }
-    size_t n = fread(text, 1, sizeof text, f);
-    int bad = ferror(f);
-    fclose(f);
-    if (bad || n > PROFILE_MAX_BYTES) {
-        fprintf(stderr, "fw_bake: %s: cannot read (at most %u bytes)\n", path, (unsigned)PROFILE_MAX_BYTES);
-        return 2;
-    }
     static gs_core_config cfg;
     static core_ctx cc;
     gs_core_config_default(&cfg);
@@ -148,8 +129,9 @@ int main(int argc, char **argv)
         memset(&e, 0, sizeof e);
         st = gs_core_config_check(&cfg, &e);
     }
+    free(text);
     if (st != GS_OK) {
-        print_error(path, &e);
+        gs_profile_print_error("fw_bake", path, &e);
         return 1;
     }
     /* whole or nothing: a temporary file renamed over OUT.h */

@@ -25,13 +25,6 @@ static uint32_t g_status;
 
 #ifndef FW_PROFILE_BAKED
 static const char k_profile[] = FW_PROFILE_TEXT;
-
-static gs_status core_section(void *ctx, const char *key, size_t key_len, const char *value,
-                              size_t value_len, char *msg, size_t cap)
-{
-    return gs_core_config_set(ctx, key, key_len, value, value_len, msg, cap);
-}
-
 #endif
 
 static void on_event(void *ctx, const gs_event *ev)
@@ -90,7 +83,7 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     g_sink = line;
 #ifndef FW_PROFILE_BAKED
     gs_cfg_error err;
-    const gs_cfg_section sec = {"core", core_section, &g_cfg};
+    const gs_cfg_section sec = {"core", gs_core_config_set, &g_cfg};
     gs_core_config_default(&g_cfg);
     g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
 #else
