@@ -12,7 +12,7 @@
 # GS_FW_LTO=OFF links the firmware without link-time optimisation.
 # A device selection (include/gravscale/gs_features.h, docs/firmware.md):
 #   GS_FW_DEVICE=all (default: every feature, the profile parsed from text)
-#     | ball-lab (point input, NMEA, compiled-in configuration, no trace events, no ransac)
+#     | ball-lab (point input, NMEA, profile baked at build time, no trace events, no ransac)
 #     | camera-coco17 | camera-blazepose33 (that skeleton layout, NMEA, parsed profile,
 #       no trace events, no ransac)
 #   GS_FW_FEATURES="GS_WITH_JSON=0 GS_WITH_BLAZEPOSE33=0"  features left out (overrides the device's)
