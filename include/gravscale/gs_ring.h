@@ -10,6 +10,7 @@
 #define GS_RING_H
 
 #include "gs_types.h"
+#include "gs_time.h"
 
 /* Samples this much older than the newest leave the ring (2^31 us = 35.8 min). */
 #define GS_RING_SPAN_US 2147483648LL
@@ -20,7 +21,7 @@ typedef struct {
     uint32_t mask;
     uint64_t head;       /* absolute index of the next sample to write */
     uint64_t valid_from; /* samples before this index fell out of the time span */
-    double t_base_s;     /* time base of t_us (the first sample's time), NaN before it */
+    int64_t t_base_us;   /* time base of t_us (the first sample's time), GS_T_NONE before it */
     int64_t t_last_us;   /* newest sample's time since the base */
     float last_up_x, last_up_y;  /* newest sample's body axis (not kept per sample) */
 } gs_ring;
@@ -32,13 +33,13 @@ typedef struct {
 
 /* capacity must be a power of two >= 8. */
 gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity);
-/* Store s (packed). GS_EINVAL: NULL or a non-finite time or one more than
- * 2^62 us from the base; GS_EORDER: s is older than the newest sample (whole
- * microseconds; an equal time is stored). */
+/* Store s (packed). GS_EINVAL: NULL or a time of GS_T_NONE or beyond
+ * GS_T_MAX_US; GS_EORDER: s is older than the newest sample (an equal time is
+ * stored). */
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s);
-/* Microseconds since the time base that t_s would be stored as (the first
- * sample sets the base); INT64_MIN when not representable. */
-int64_t gs_ring_time_us(const gs_ring *r, double t_s);
+/* Microseconds since the time base that t_us would be stored as (the first
+ * sample sets the base); INT64_MIN for GS_T_NONE or a time beyond GS_T_MAX_US. */
+int64_t gs_ring_time_us(const gs_ring *r, int64_t t_us);
 /* Absolute index of the oldest sample still held (== head when empty). */
 uint64_t gs_ring_oldest(const gs_ring *r);
 uint64_t gs_ring_head(const gs_ring *r);
@@ -49,7 +50,7 @@ const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i);
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out);
 
 /* Field accessors of a held sample (s from gs_ring_at of the same ring). */
-double gs_ring_sample_t_s(const gs_ring *r, const gs_sample *s);
+int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s);  /* absolute */
 float gs_sample_w(const gs_sample *s);
 float gs_sample_size_px(const gs_sample *s);  /* NaN unknown */
 float gs_sample_upright(const gs_sample *s);  /* NaN unknown */
