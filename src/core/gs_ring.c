@@ -4,15 +4,11 @@
 
 #include <math.h>
 
-#include "gs_dbits.h"
-
 #define SIZE_FINE_Q 0x8000u      /* codes below: 1/16 px steps */
 #define SIZE_FINE_PX 2048.0f     /* ... up to here, then 1/4 px steps */
 #define SIZE_UNKNOWN 0xFFFFu
 #define UPRIGHT_STEPS 250.0f
 #define UPRIGHT_UNKNOWN 255u
-/* Beyond 2^62 us (146 000 years) from the base a time is refused: int64 stays safe. */
-#define TIME_MAX_US 4.6e18
 
 gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
 {
@@ -24,28 +20,25 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
     r->mask = capacity - 1u;
     r->head = 0;
     r->valid_from = 0;
-    r->t_base_s = (double)NAN;
+    r->t_base_us = GS_T_NONE;
     r->t_last_us = 0;
     r->last_up_x = NAN;
     r->last_up_y = NAN;
     return GS_OK;
 }
 
-int64_t gs_ring_time_us(const gs_ring *r, double t_s)
+int64_t gs_ring_time_us(const gs_ring *r, int64_t t_us)
 {
-    if (!r || !gs_dfinite(t_s)) {
+    if (!r || t_us == GS_T_NONE || t_us > GS_T_MAX_US || t_us < -GS_T_MAX_US) {
         return INT64_MIN;
     }
-    /* the first sample becomes the base; double because it is an absolute time */
-    double base = gs_dfinite(r->t_base_s) ? r->t_base_s : t_s;
-    double us = (t_s - base) * 1e6;
-    double mag_us = fabs(us);
-    if (!gs_dlt(mag_us, TIME_MAX_US)) {
+    /* the first sample becomes the base */
+    int64_t base = r->t_base_us == GS_T_NONE ? t_us : r->t_base_us;
+    /* no more than 2^62 us from the base either (both within +-2^62: the bounds do not overflow) */
+    if (base > 0 ? t_us < base - GS_T_MAX_US : t_us > base + GS_T_MAX_US) {
         return INT64_MIN;
     }
-    /* round half away from zero without libm's llround: the magnitude, then the sign */
-    int64_t n = (int64_t)gs_dtrunc_abs(mag_us + 0.5);
-    return signbit(us) ? -n : n;
+    return t_us - base;
 }
 
 static uint16_t size_pack(float size_px)
@@ -121,16 +114,16 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     if (!r || !s || !r->buf) {
         return GS_EINVAL;
     }
-    int64_t us = gs_ring_time_us(r, s->t_s);
+    int64_t us = gs_ring_time_us(r, s->t_us);
     if (us == INT64_MIN) {
         return GS_EINVAL;
     }
-    bool first = !gs_dfinite(r->t_base_s);
+    bool first = r->t_base_us == GS_T_NONE;
     if (!first && us < r->t_last_us) {
         return GS_EORDER;
     }
     if (first) {
-        r->t_base_s = s->t_s;
+        r->t_base_us = s->t_us;
         us = 0;
     } else if (us - r->t_last_us >= GS_RING_SPAN_US) {
         r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
@@ -188,14 +181,13 @@ const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i)
     return &r->buf[(uint32_t)(i & r->mask)];
 }
 
-double gs_ring_sample_t_s(const gs_ring *r, const gs_sample *s)
+int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s)
 {
     /* held samples are less than 2^31 us older than the newest: the modular
      * difference is their exact age, across any wrap of the 32-bit field */
     uint32_t age = (uint32_t)r->t_last_us - s->t_us;
     int64_t us = r->t_last_us - (int64_t)age;
-    /* double: an absolute time of a stream that may run for days */
-    return r->t_base_s + (double)us / 1e6;
+    return r->t_base_us + us;  /* the time that was pushed: no overflow */
 }
 
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)
@@ -204,7 +196,7 @@ bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)
     if (!s || !out) {
         return false;
     }
-    out->t_s = gs_ring_sample_t_s(r, s);
+    out->t_us = gs_ring_sample_t_us(r, s);
     out->x_px = s->x_px;
     out->y_px = s->y_px;
     out->w = gs_sample_w(s);

@@ -2,6 +2,7 @@
 #include "gravscale/gs_time.h"
 
 #include <math.h>
+#include <string.h>
 
 #define SPAN_MAX_US INT32_MAX  /* spans saturate here where gs_real is float */
 
@@ -31,6 +32,7 @@ gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us)
 int64_t gs_time_add_s(int64_t t_us, gs_real ds)
 {
     if (t_us == GS_T_NONE || !(GS_FABS(ds) < GS_R(2147483648.0))) return GS_T_NONE;  /* NaN fails too */
+    if (t_us > GS_T_MAX_US || t_us < -GS_T_MAX_US) return GS_T_NONE;  /* no time is there: the sum could overflow */
     int64_t d_us;
     ROUND_SPLIT_US(gs_real, ds, d_us);
     return t_us + d_us;  /* |t| <= 2^62 and |d| < 2^51: no overflow */
@@ -39,15 +41,24 @@ int64_t gs_time_add_s(int64_t t_us, gs_real ds)
 int64_t gs_time_us_of_cfg_s(float s)
 {
     if (!(s >= 0.0f && s < 2147483648.0f)) return GS_T_NONE;
-    int64_t us;
-    ROUND_SPLIT_US(float, s, us);
-    return us;
+    /* exactly rounded from the bits, s = m 2^sh: a float product (frac * 1e6) could be
+     * 1 us off (8.579f -> 8579001); integer multiply and shift are cheap everywhere */
+    uint32_t b;
+    memcpy(&b, &s, sizeof b);
+    uint32_t ex = (b >> 23) & 0xFFu;
+    if (ex == 0u) return 0;  /* +-0 and subnormals: far below half a microsecond */
+    uint64_t p = (uint64_t)((b & 0x7FFFFFu) | 0x800000u) * (uint64_t)GS_US_PER_S;  /* < 2^44 */
+    int sh = (int)ex - 150;                                                        /* <= 7 below 2^31 s */
+    if (sh >= 0) return (int64_t)(p << sh);
+    if (sh < -45) return 0;  /* below 2^-1 us */
+    return (int64_t)((p + (UINT64_C(1) << (-sh - 1))) >> -sh);  /* half up: s >= 0 */
 }
 
 int64_t gs_time_us_of_s(double t_s)
 {
-    if (!(fabs(t_s) <= (double)GS_T_MAX_US / 1e6)) return GS_T_NONE;  /* NaN fails too */
-    return (int64_t)llround(t_s * 1e6);
+    double us = t_s * 1e6;  /* the limit on the product: t_s at the bound may round past it */
+    if (!(fabs(us) <= (double)GS_T_MAX_US)) return GS_T_NONE;  /* NaN fails too */
+    return (int64_t)llround(us);
 }
 
 double gs_time_s_of_us(int64_t t_us)
