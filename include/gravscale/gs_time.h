@@ -17,16 +17,22 @@
 #define GS_T_MAX_US (INT64_C(1) << 62)       /* times beyond +-2^62 us (146 000 years) are refused */
 #define GS_US_PER_S 1000000
 
-/* t1 - t0 in seconds; NaN when either is GS_T_NONE. Where gs_real is float the
- * span saturates at +-2^31 us (only spans inside the ring, which are shorter,
- * take part in arithmetic). */
+/* A time the core accepts: within +-GS_T_MAX_US (GS_T_NONE is not). Any two such
+ * times have a difference that fits int64_t. */
+static inline bool gs_time_ok(int64_t t_us) { return t_us >= -GS_T_MAX_US && t_us <= GS_T_MAX_US; }
+
+/* t1 - t0 (both gs_time_ok or GS_T_NONE) in microseconds, exact below 2^53 us
+ * (double) or 2^24 us (float); NaN when either is GS_T_NONE. Where gs_real is float the span saturates at +-2^31 us
+ * (only spans inside the ring, which are shorter, take part in arithmetic). */
+gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us);
+/* The same in seconds. */
 gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us);
-/* t + ds rounded to the nearest microsecond; GS_T_NONE when t is, or ds is not
- * finite or |ds| >= 2^31 s. */
+/* t + ds rounded to the nearest microsecond; GS_T_NONE when t is not gs_time_ok,
+ * or ds is not finite or |ds| >= 2^31 s. */
 int64_t gs_time_add_s(int64_t t_us, gs_real ds);
-/* A configured span in whole microseconds (rounded; spans are >= 0 and < 2^31 s:
- * the config checks bound them). Computed in float on every build, so that the
- * host and the device compare against the same integer. */
+/* A configured span in whole microseconds, rounded exactly from the float's bits
+ * (integer arithmetic: the host and the device compare against the same integer);
+ * GS_T_NONE unless 0 <= s < 2^31 s (the config checks bound every span far below). */
 int64_t gs_time_us_of_cfg_s(float s);
 
 /* At the edge, for callers on double seconds (hosts; a device passes microseconds):

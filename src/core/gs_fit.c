@@ -27,29 +27,12 @@
 
 static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
-/* t1 - t0 microseconds as a gs_real, exact below 2^53 (double) or 2^24 (float).
- * The difference as uint64 cannot overflow for any two times; where gs_real is
- * float it saturates at 2^31 us, so that it converts from int32 (one instruction,
- * where int64 would be a libgcc call). */
-static gs_real span_us(int64_t t1_us, int64_t t0_us)
-{
-    bool neg = t1_us < t0_us;
-    uint64_t mag = neg ? (uint64_t)t0_us - (uint64_t)t1_us : (uint64_t)t1_us - (uint64_t)t0_us;
-    gs_real r;
-    if (GS_REAL_IS_FLOAT) {
-        r = (gs_real)(int32_t)(mag > (uint64_t)INT32_MAX ? (uint64_t)INT32_MAX : mag);
-    } else {
-        r = (gs_real)mag;
-    }
-    return neg ? -r : r;
-}
-
 /* An empty fit at a valid centre and scale (> 0 us): all sums and R zero (all-zero bits are +0.0). */
 static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
 {
     memset(f, 0, sizeof *f);
     f->t0_us = t0_us;
-    f->tscale_s = span_us(tscale_us, 0) / GS_R(1e6);
+    f->tscale_s = gs_time_span_s(tscale_us, 0);
 }
 
 void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
@@ -58,8 +41,7 @@ void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
         return;
     }
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    bool t0_ok = t0_us != GS_T_NONE && t0_us <= GS_T_MAX_US && t0_us >= -GS_T_MAX_US;
-    fit_start(f, t0_ok ? t0_us : 0, tscale_us > 0 ? tscale_us : GS_US_PER_S);
+    fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, tscale_us > 0 ? tscale_us : GS_US_PER_S);
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -72,7 +54,7 @@ static int rix(int i, int j)
 /* The centred, scaled time of t_us: the exact integer span over the scale, both in microseconds. */
 static gs_real fit_tau(int64_t t_us, int64_t t0_us, gs_real tscale_us)
 {
-    return span_us(t_us, t0_us) / tscale_us;
+    return gs_time_span_us(t_us, t0_us) / tscale_us;
 }
 
 /* Entry j of row k of the augmented factor [R | zx zy]: columns 0-2 are R's, 3 and 4 the right-hand sides. */
@@ -118,7 +100,7 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
 
 void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
 {
-    if (!f || !(w > GS_R(0.0)) || !isfinite(w) || t_us == GS_T_NONE || !isfinite(x_px) || !isfinite(y_px)) {
+    if (!f || !(w > GS_R(0.0)) || !isfinite(w) || !gs_time_ok(t_us) || !isfinite(x_px) || !isfinite(y_px)) {
         return;
     }
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
@@ -674,7 +656,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
     wn->tscale_us = t_max - t_min;  /* held samples are less than 2^31 us apart */
     wn->t0_us = t_min + (wn->tscale_us >> 1);  /* a shift: no 64-bit division */
-    wn->tscale_us_r = span_us(wn->tscale_us, 0);
+    wn->tscale_us_r = gs_time_span_us(wn->tscale_us, 0);
     return GS_OK;
 }
 

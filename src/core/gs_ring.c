@@ -29,7 +29,7 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
 
 int64_t gs_ring_time_us(const gs_ring *r, int64_t t_us)
 {
-    if (!r || t_us == GS_T_NONE || t_us > GS_T_MAX_US || t_us < -GS_T_MAX_US) {
+    if (!r || !gs_time_ok(t_us)) {
         return INT64_MIN;
     }
     /* the first sample becomes the base */

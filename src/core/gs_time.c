@@ -6,7 +6,10 @@
 
 #define SPAN_MAX_US INT32_MAX  /* spans saturate here where gs_real is float */
 
-gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us)
+/* one copy (called per sample by the fits and the flight): inlined, it grows every caller */
+#define NOINLINE __attribute__((noinline))
+
+NOINLINE gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us)
 {
     if (t1_us == GS_T_NONE || t0_us == GS_T_NONE) return (gs_real)NAN;
     int64_t d = t1_us - t0_us;  /* both within +-2^62: no overflow */
@@ -14,28 +17,25 @@ gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us)
         /* int32 -> float is one instruction; int64 -> float a libgcc call */
         if (d > SPAN_MAX_US) d = SPAN_MAX_US;
         if (d < -SPAN_MAX_US) d = -SPAN_MAX_US;
-        return (gs_real)(int32_t)d / GS_R(1e6);
+        return (gs_real)(int32_t)d;
     }
-    return (gs_real)d / GS_R(1e6);
+    return (gs_real)d;
 }
 
-/* whole seconds and the rest: the rest (|x| < 1) scales to microseconds with its
- * full precision, and both conversions are single instructions */
-#define ROUND_SPLIT_US(type, x, out)                                                  \
-    do {                                                                              \
-        int32_t whole_ = (int32_t)(x);                                                \
-        type frac_us_ = ((x) - (type)whole_) * (type)1e6;                             \
-        int32_t f_ = (int32_t)(frac_us_ + (frac_us_ < (type)0 ? (type)-0.5 : (type)0.5)); \
-        (out) = (int64_t)whole_ * GS_US_PER_S + f_;                                   \
-    } while (0)
+NOINLINE gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us)
+{
+    return gs_time_span_us(t1_us, t0_us) / GS_R(1e6);
+}
 
 int64_t gs_time_add_s(int64_t t_us, gs_real ds)
 {
-    if (t_us == GS_T_NONE || !(GS_FABS(ds) < GS_R(2147483648.0))) return GS_T_NONE;  /* NaN fails too */
-    if (t_us > GS_T_MAX_US || t_us < -GS_T_MAX_US) return GS_T_NONE;  /* no time is there: the sum could overflow */
-    int64_t d_us;
-    ROUND_SPLIT_US(gs_real, ds, d_us);
-    return t_us + d_us;  /* |t| <= 2^62 and |d| < 2^51: no overflow */
+    if (!gs_time_ok(t_us) || !(GS_FABS(ds) < GS_R(2147483648.0))) return GS_T_NONE;  /* NaN fails too */
+    /* whole seconds and the rest: the rest (|x| < 1) scales to microseconds with its
+     * full precision, and both conversions are single instructions */
+    int32_t whole_s = (int32_t)ds;
+    gs_real frac_us = (ds - (gs_real)whole_s) * GS_R(1e6);
+    int32_t frac_whole_us = (int32_t)(frac_us + (frac_us < GS_R(0.0) ? GS_R(-0.5) : GS_R(0.5)));
+    return t_us + (int64_t)whole_s * GS_US_PER_S + frac_whole_us;  /* |t| <= 2^62, the rest < 2^51 */
 }
 
 int64_t gs_time_us_of_cfg_s(float s)
