@@ -1,8 +1,8 @@
 /* gs_ring.h - fixed-capacity ring of 16-byte gs_sample in caller storage. Oldest
  * samples are overwritten when full; absolute sample indices keep counting so
  * that a flight window can be addressed as [first, first+count). Times are kept
- * as microseconds since a time base (the first sample's time) modulo 2^32 and
- * are read back relative to the newest sample, so the 32-bit field may wrap
+ * as their microseconds modulo 2^32 and read back relative to the newest
+ * sample's (kept whole), so the 32-bit field may wrap
  * (every 71.6 min) at any point: the ring holds only samples less than
  * GS_RING_SPAN_US older than the newest (older ones leave it as if
  * overwritten), and a time difference inside it is always exact. */
@@ -21,8 +21,7 @@ typedef struct {
     uint32_t mask;
     uint64_t head;       /* absolute index of the next sample to write */
     uint64_t valid_from; /* samples before this index fell out of the time span */
-    int64_t t_base_us;   /* time base of t_us (the first sample's time), GS_T_NONE before it */
-    int64_t t_last_us;   /* newest sample's time since the base */
+    int64_t t_last_us;   /* newest sample's time, GS_T_NONE before the first */
     float last_up_x, last_up_y;  /* newest sample's body axis (not kept per sample) */
 } gs_ring;
 
@@ -33,13 +32,10 @@ typedef struct {
 
 /* capacity must be a power of two >= 8. */
 gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity);
-/* Store s (packed). GS_EINVAL: NULL or a time of GS_T_NONE or beyond
- * GS_T_MAX_US; GS_EORDER: s is older than the newest sample (an equal time is
- * stored). */
+/* Store s (packed). GS_EINVAL: NULL or a time that is not gs_time_ok (GS_T_NONE,
+ * beyond GS_T_MAX_US); GS_EORDER: s is older than the newest sample (an equal
+ * time is stored). */
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s);
-/* Microseconds since the time base that t_us would be stored as (the first
- * sample sets the base); INT64_MIN for GS_T_NONE or a time beyond GS_T_MAX_US. */
-int64_t gs_ring_time_us(const gs_ring *r, int64_t t_us);
 /* Absolute index of the oldest sample still held (== head when empty). */
 uint64_t gs_ring_oldest(const gs_ring *r);
 uint64_t gs_ring_head(const gs_ring *r);

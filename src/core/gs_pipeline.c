@@ -135,11 +135,12 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
         if (s->t_us < p->last_t_us) return GS_EORDER;
         if (s->t_us == p->last_t_us) return GS_OK;  /* a repeated frame carries nothing new */
     }
-    int64_t us = gs_ring_time_us(&p->ring, s->t_us);
-    if (us == INT64_MIN) return GS_ERANGE;  /* beyond GS_T_MAX_US (or that far from the first frame) */
+    if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
-     * left open must close on them first (as it would on any long gap) */
-    if (p->n_frames > 0 && us - p->ring.t_last_us >= GS_RING_SPAN_US) gs_flight_break(&p->flight);
+     * left open must close on them first (as it would on any long gap); the
+     * difference as uint64 is exact for any two accepted times */
+    if (p->last_t_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)p->last_t_us >= (uint64_t)GS_RING_SPAN_US)
+        gs_flight_break(&p->flight);
     gs_status st = gs_ring_push(&p->ring, s);
     if (st != GS_OK) return st;
     p->last_t_us = s->t_us;
