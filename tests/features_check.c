@@ -58,9 +58,11 @@ static void run_ball(void)
     CHECK(gs_pipeline_init(&pipe, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, NULL) == GS_OK);
     gs_pipeline_set_trace(&pipe, true);
     for (int i = 0; i < 6 * 60; i++) {
-        double t = 1000.0 + i / 60.0, x = fmod(i / 60.0, 0.6);
+        /* microseconds as a device counts them (and as fw_scenario.c pushes them) */
+        int64_t t_us = INT64_C(1000000000) + (int64_t)(((uint32_t)i * 1000000u + 30u) / 60u);
+        double x = fmod(i / 60.0, 0.6);
         double h = x > 0.45 ? 0.0 : 0.5 * 9.81 * 0.45 * x - 0.5 * 9.81 * x * x;
-        CHECK(gs_pipeline_push_point(&pipe, t, 320.0f, (float)(400.0 - h / 0.002), 1.0f, 34.35f) == GS_OK);
+        CHECK(gs_pipeline_push_point_us(&pipe, t_us, 320.0f, (float)(400.0 - h / 0.002), 1.0f, 34.35f) == GS_OK);
     }
     CHECK(gs_pipeline_flush(&pipe) == GS_OK);
     CHECK(g_len > 0);

@@ -59,7 +59,8 @@ void on_event(void *ctx, const gs_event *ev)
         r->flights.push_back({(int)j.track, j.accepted, j.height_m, j.q_m_per_px, j.size_px});
         if (std::getenv("GS_TEST_VERBOSE"))
             std::printf("  flight track %u %.3f-%.3f s: size %.4f m, %s %s, rms %.2f px, n %u\n", j.track,
-                        j.t_takeoff_s, j.t_land_s, j.height_m, j.accepted ? "accepted" : "rejected",
+                        gs_time_s_of_us(j.t_takeoff_us), gs_time_s_of_us(j.t_land_us), j.height_m,
+                        j.accepted ? "accepted" : "rejected",
                         gs_reject_reason_name(j.reason), j.rms_px, j.n_samples);
     } else if (ev->type == GS_EV_SUMMARY) {
         r->summary[(int)ev->u.height.track] = ev->u.height.height_m;

@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <deque>
 #include <string>
@@ -326,6 +327,9 @@ static void test_v4l2_mjpeg_negotiation_timestamps_drops_unplug(void)
         TEST_ASSERT_EQUAL_INT64(k, f.index);
         TEST_ASSERT_EQUAL_INT64(i, f.sequence);
         TEST_ASSERT_DOUBLE_WITHIN(1.5e-6, kT0 + i / kFps, f.t_s);
+        // the driver's whole microseconds reach the core exactly (as the fake set them)
+        const double t = kT0 + i / kFps, whole = std::floor(t);
+        TEST_ASSERT_EQUAL_INT64(static_cast<int64_t>(whole) * 1000000 + std::lround((t - whole) * 1e6), f.t_us);
         cv::Point2d c = find_disc(f.bgr), truth = disc_centre(i);
         TEST_ASSERT_DOUBLE_WITHIN(0.3, truth.x, c.x);
         TEST_ASSERT_DOUBLE_WITHIN(0.3, truth.y, c.y);
@@ -487,6 +491,7 @@ static void test_gstreamer_videotestsrc(void)
             TEST_ASSERT_EQUAL_INT(160, f.bgr.cols);
             TEST_ASSERT_EQUAL_INT(120, f.bgr.rows);
             t.push_back(f.t_s);
+            TEST_ASSERT_EQUAL_INT64(INT64_MIN, f.t_us);  // no integer clock: seconds only
         }
         TEST_ASSERT_EQUAL_INT(40, static_cast<int>(t.size()));
         for (size_t i = 1; i < t.size(); i++) {

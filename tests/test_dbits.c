@@ -1,11 +1,13 @@
 /* test_dbits.c - the core's double tests from the IEEE bits (src/core/gs_dbits.h,
- * what the Cortex-M4 firmware uses instead of libgcc's compare and truncation
+ * what the Cortex-M4 firmware uses instead of libgcc's compare and conversion
  * routines) against the native operators: special values (NaN of both signs,
  * +-0, +-inf, subnormals, the largest and smallest doubles, neighbours of
- * integers) in every pair, and a million random bit patterns. */
+ * integers) in every pair, and a million random bit patterns; and the float to
+ * double widening from the bits. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "../src/core/gs_dbits.h"
@@ -47,14 +49,12 @@ static void check_pair(double a, double b)
 {
     int c = gs_dcmp(a, b);
     TEST_ASSERT_EQUAL_INT(native_cmp(a, b), c);
-    /* the soft-double forms of gs_dlt/dle/dgt/dge (gs_dbits.h), also on a host */
+    /* the soft-double forms of gs_dle/dge (gs_dbits.h) and of < and >, also on a host */
     TEST_ASSERT_EQUAL_INT(a < b, c < 0);
     TEST_ASSERT_EQUAL_INT(a <= b, c <= 0);
     TEST_ASSERT_EQUAL_INT(a > b, c == 1);
     TEST_ASSERT_EQUAL_INT(a >= b, (unsigned)c <= 1u);
-    TEST_ASSERT_EQUAL_INT(a < b, gs_dlt(a, b));
     TEST_ASSERT_EQUAL_INT(a <= b, gs_dle(a, b));
-    TEST_ASSERT_EQUAL_INT(a > b, gs_dgt(a, b));
     TEST_ASSERT_EQUAL_INT(a >= b, gs_dge(a, b));
 }
 
@@ -80,31 +80,54 @@ static void test_predicates(void)
         double x = k_special[i];
         TEST_ASSERT_EQUAL_INT(isfinite(x), gs_dfinite(x));
         TEST_ASSERT_EQUAL_INT(isnan(x), gs_disnan(x));
-        TEST_ASSERT_EQUAL_INT(isfinite(x) && x > 0.0, gs_dpositive(x));
     }
     for (int i = 0; i < 200000; i++) {
         double x = from_bits(next_u64());
         TEST_ASSERT_EQUAL_INT(isfinite(x), gs_dfinite(x));
         TEST_ASSERT_EQUAL_INT(isnan(x), gs_disnan(x));
-        TEST_ASSERT_EQUAL_INT(isfinite(x) && x > 0.0, gs_dpositive(x));
     }
 }
 
-/* trunc(|x|) for |x| < 2^64, as the cast does */
-static void test_trunc_abs(void)
+static uint64_t dbits_of(double x)
 {
-    static const double k_vals[] = {0.0, -0.0, 0.49999999999999994, 0.5, 0.9999999999999999, 1.0, -1.0, 1.5,
-                                    2.5, -2.5, 4503599627370495.5, 4503599627370496.0, 9007199254740993.0,
-                                    1e15 + 0.3, 2147483648.0, 4294967295.9, 18446744073709549568.0, 5e-324};
-    for (size_t i = 0; i < sizeof k_vals / sizeof k_vals[0]; i++)
-        TEST_ASSERT_EQUAL_UINT64((uint64_t)fabs(k_vals[i]), gs_dtrunc_abs(k_vals[i]));
-    for (int i = 0; i < 1000000; i++) {
-        /* exponents 2^-3 .. 2^63 and both signs */
-        uint64_t b = next_u64();
-        uint64_t ex = 1020u + (b >> 52) % 67u;
-        double x = from_bits((b & 0x800FFFFFFFFFFFFFull) | (ex << 52));
-        TEST_ASSERT_EQUAL_UINT64((uint64_t)fabs(x), gs_dtrunc_abs(x));
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* (double)f from the bits: every subnormal and every exponent, the specials, a
+ * million random floats; bit for bit the conversion's result (a signalling NaN's
+ * conversion also sets the quiet bit, which gs_dwiden keeps as it was) */
+static void check_widen(uint32_t fb)
+{
+    float f;
+    memcpy(&f, &fb, sizeof f);
+    uint64_t got = dbits_of(gs_dwiden(f)), want = dbits_of((double)f);
+    if (isnan(f)) got |= 1ull << 51;
+    if (got != want) {
+        char msg[64];
+        snprintf(msg, sizeof msg, "float bits 0x%08x", (unsigned)fb);
+        TEST_FAIL_MESSAGE(msg);
     }
+}
+
+static void test_widen_float(void)
+{
+    static const uint32_t k_bits[] = {0x00000000u, 0x80000000u, 0x00000001u, 0x80000001u, 0x007FFFFFu,
+                                      0x00800000u, 0x3F800000u, 0xBF800000u, 0x7F7FFFFFu, 0xFF7FFFFFu,
+                                      0x7F800000u, 0xFF800000u, 0x7FC00000u, 0xFFC00000u, 0x7F800001u,
+                                      0x7FFFFFFFu, 0xFFBFFFFFu, 0x3EAAAAABu, 0x4B189680u};
+    for (size_t i = 0; i < sizeof k_bits / sizeof k_bits[0]; i++) check_widen(k_bits[i]);
+    for (uint32_t m = 0; m < 0x800000u; m++) {  /* every subnormal, both signs */
+        check_widen(m);
+        check_widen(m | 0x80000000u);
+    }
+    for (uint32_t e = 0; e < 256u; e++)  /* every exponent with a few mantissas */
+        for (uint32_t k = 0; k < 64u; k++) check_widen(e << 23 | ((uint32_t)next_u64() & 0x807FFFFFu));
+    for (int i = 0; i < 1000000; i++) check_widen((uint32_t)next_u64());
+    TEST_ASSERT_TRUE(isnan(gs_dwiden(NAN)));
+    TEST_ASSERT_TRUE(gs_dwiden(-0.0f) == 0.0 && signbit(gs_dwiden(-0.0f)));
+    TEST_ASSERT_TRUE(gs_dwiden(FLT_TRUE_MIN) == 0x1p-149);
 }
 
 int main(void)
@@ -113,6 +136,6 @@ int main(void)
     RUN_TEST(test_compare_special_pairs);
     RUN_TEST(test_compare_random);
     RUN_TEST(test_predicates);
-    RUN_TEST(test_trunc_abs);
+    RUN_TEST(test_widen_float);
     return UNITY_END();
 }

@@ -232,10 +232,10 @@ static gs_event ev_jump(void)
     gs_ev_jump *j = &e.u.jump;
     j->track = 0;
     j->index = 3;
-    j->t_takeoff_s = 12.3456789;
-    j->t_land_s = 12.8123;
+    j->t_takeoff_us = 12345679;
+    j->t_land_us = 12812300;
     j->flight_time_s = 0.46662;
-    j->t_apex_s = 12.579;
+    j->t_apex_us = 12579000;
     j->a_px_s2 = 2345.678912;
     j->a_px_se_s2 = 12.3456789;
     j->g_dir_deg = -1.234;
@@ -303,7 +303,7 @@ void test_json_exact_lines(void)
     e.u.jump.height_se_m = INFINITY;
     e.u.jump.q_m_per_px = 1.5e-05;
     e.u.jump.a_px_s2 = 654321.4;
-    e.u.jump.t_takeoff_s = 1e16; /* beyond fixed notation: unknown */
+    e.u.jump.t_takeoff_us = GS_T_NONE; /* unknown */
     check_exact(&e, "{\"event\":\"jump\",\"track\":0,\"index\":3,\"t_takeoff_s\":null,\"t_land_s\":12.8123,"
                     "\"flight_time_s\":0.4666,\"t_apex_s\":12.5790,\"a_px_s2\":654321,\"a_px_se_s2\":12.3457,"
                     "\"g_dir_deg\":-1.23,\"q_m_per_px\":1.5e-05,\"size_px\":412.35,\"height_m\":null,"
@@ -340,14 +340,14 @@ void test_json_exact_lines(void)
 
     memset(&e, 0, sizeof e);
     e.type = GS_EV_STATE;
-    e.u.state.t_s = 3.00006;
+    e.u.state.t_us = 3000060;
     e.u.state.from = "ground";
     e.u.state.to = "airborne";
     check_exact(&e, "{\"event\":\"state\",\"t_s\":3.0001,\"from\":\"ground\",\"to\":\"airborne\"}\n");
 
     memset(&e, 0, sizeof e);
     e.type = GS_EV_SAMPLE;
-    e.u.sample.t_s = 0.0333333;
+    e.u.sample.t_us = 33333;
     e.u.sample.x_px = 640.25f;
     e.u.sample.y_px = -12.5f;
     e.u.sample.w = 0.875f;
@@ -359,14 +359,30 @@ void test_json_exact_lines(void)
     memset(&e, 0, sizeof e);
     e.type = GS_EV_FIT;
     e.u.fit.purpose = "final";
-    e.u.fit.t_first_s = 1.0;
-    e.u.fit.t_last_s = 1.4;
+    e.u.fit.t_first_us = 1000000;
+    e.u.fit.t_last_us = 1400000;
     e.u.fit.n = 13;
     e.u.fit.a_px_s2 = 2400.0;
     e.u.fit.g_dir_deg = 0.5;
     e.u.fit.rms_px = NAN;
     check_exact(&e, "{\"event\":\"fit\",\"purpose\":\"final\",\"t_first_s\":1.0000,\"t_last_s\":1.4000,\"n\":13,"
                     "\"a_px_s2\":2400,\"g_dir_deg\":0.50,\"rms_px\":null}\n");
+
+    /* times: the field's decimals of the exact seconds, rounded half away from zero */
+    static const struct { int64_t t_us; const char *want; } times[] = {
+        {0, "0.0000"}, {50, "0.0001"}, {49, "0.0000"}, {-49, "0.0000"}, {-50, "-0.0001"},
+        {-1234550, "-1.2346"}, {-1234549, "-1.2345"}, {1234550, "1.2346"}, {999999950, "1000.0000"},
+        {-999999950, "-1000.0000"}, {GS_T_MAX_US, "4611686018427.3879"}, {-GS_T_MAX_US, "-4611686018427.3879"},
+        {INT64_MAX, "9223372036854.7758"}, {INT64_MIN + 1, "-9223372036854.7758"}, {GS_T_NONE, "null"},
+    };
+    for (size_t k = 0; k < sizeof times / sizeof times[0]; k++) {
+        char want[96];
+        memset(&e, 0, sizeof e);
+        e.type = GS_EV_WARNING;
+        e.u.warning.t_us = times[k].t_us;
+        snprintf(want, sizeof want, "{\"event\":\"warning\",\"track\":0,\"t_s\":%s,\"warnings\":[]}\n", times[k].want);
+        check_exact(&e, want);
+    }
 
     e.type = (gs_event_type)99;
     strcpy(buf, "junk");
@@ -391,6 +407,18 @@ static double rnd_val(int i)
     }
 }
 
+/* a random time: unknown, near zero, a day-long stream, near the limits */
+static int64_t rnd_time(int i)
+{
+    switch (i % 5) {
+    case 0: return GS_T_NONE;
+    case 1: return (int64_t)((rnd_unit() - 0.5) * 2e6);
+    case 2: return (int64_t)(rnd_unit() * 86400e6);
+    case 3: return (int64_t)((rnd_unit() - 0.5) * 2.0 * 4.6e18);
+    default: return -(int64_t)(rnd_unit() * 1e13);
+    }
+}
+
 /* random jumps: every field parses back to its truth within the format's rounding */
 void test_json_jump_roundtrip_random(void)
 {
@@ -398,10 +426,12 @@ void test_json_jump_roundtrip_random(void)
     for (int it = 0; it < 5000; it++) {
         gs_event e = ev_jump();
         gs_ev_jump *j = &e.u.jump;
-        double *d[] = {&j->t_takeoff_s, &j->t_land_s, &j->flight_time_s, &j->t_apex_s, &j->a_px_s2,
-                       &j->a_px_se_s2, &j->g_dir_deg, &j->q_m_per_px, &j->size_px, &j->height_m,
-                       &j->height_se_m, &j->jump_height_m, &j->takeoff_velocity_m_s, &j->rms_px};
+        gs_real *d[] = {&j->flight_time_s, &j->a_px_s2, &j->a_px_se_s2, &j->g_dir_deg, &j->q_m_per_px,
+                        &j->size_px, &j->height_m, &j->height_se_m, &j->jump_height_m, &j->takeoff_velocity_m_s,
+                        &j->rms_px};
         for (size_t k = 0; k < sizeof d / sizeof d[0]; k++) *d[k] = rnd_val(it + (int)k * 3 + (int)(rnd_unit() * 5));
+        int64_t *tm[] = {&j->t_takeoff_us, &j->t_land_us, &j->t_apex_us};
+        for (size_t k = 0; k < 3; k++) *tm[k] = rnd_time(it + (int)k);
         j->track = (uint32_t)(rnd_unit() * 4);
         j->index = it % 7 == 0 ? UINT32_MAX : (uint32_t)it;
         j->n_samples = (uint32_t)(rnd_unit() * 4e9);
@@ -416,10 +446,10 @@ void test_json_jump_roundtrip_random(void)
         TEST_ASSERT_EQUAL_INT_MESSAGE(22, nv, buf);
         for (int k = 0; k < 22; k++) TEST_ASSERT_EQUAL_STRING(k_jump_keys[k], v[k].key);
         TEST_ASSERT_EQUAL_DOUBLE((double)j->index, v[2].num);
-        check_num(v, nv, "t_takeoff_s", fabs(j->t_takeoff_s) < 1e15 ? j->t_takeoff_s : NAN, 0.5e-4, 0);
-        check_num(v, nv, "t_land_s", j->t_land_s, 0.5e-4, 0);
+        check_num(v, nv, "t_takeoff_s", gs_time_s_of_us(j->t_takeoff_us), 0.5e-4, 0);
+        check_num(v, nv, "t_land_s", gs_time_s_of_us(j->t_land_us), 0.5e-4, 0);
         check_num(v, nv, "flight_time_s", j->flight_time_s, 0.5e-4, 0);
-        check_num(v, nv, "t_apex_s", j->t_apex_s, 0.5e-4, 0);
+        check_num(v, nv, "t_apex_s", gs_time_s_of_us(j->t_apex_us), 0.5e-4, 0);
         check_num(v, nv, "a_px_s2", j->a_px_s2, 0, 0.5e-5);
         check_num(v, nv, "a_px_se_s2", j->a_px_se_s2, 0, 0.5e-5);
         check_num(v, nv, "g_dir_deg", j->g_dir_deg, 0.5e-2, 0);
@@ -599,7 +629,7 @@ void test_nmea_worst_case(void)
     char buf[GS_EMIT_MAX];
     gs_event e = ev_jump();
     gs_ev_jump *j = &e.u.jump;
-    j->t_takeoff_s = -99999.999;
+    j->t_takeoff_us = -99999999000;
     j->flight_time_s = -9.99;
     j->a_px_s2 = -99999.9;
     j->q_m_per_px = -1.2345678;
@@ -616,14 +646,21 @@ void test_nmea_worst_case(void)
         "$GSJMP,-99999.999,-9.99,-99999.9,-1.234568,-9.999,-9.99,-99.99,4294967295,R,6*", buf, n - 4);
     /* far larger values lose decimals, then become empty: never longer */
     for (int it = 0; it < 20000; it++) {
-        double *d[] = {&j->t_takeoff_s, &j->flight_time_s, &j->a_px_s2, &j->q_m_per_px, &j->height_m,
-                       &j->jump_height_m, &j->takeoff_velocity_m_s};
+        gs_real *d[] = {NULL, &j->flight_time_s, &j->a_px_s2, &j->q_m_per_px, &j->height_m,
+                        &j->jump_height_m, &j->takeoff_velocity_m_s};
         double truth[7];
         for (size_t k = 0; k < 7; k++) {
             double mag = pow(10.0, rnd_unit() * 24 - 8);
-            *d[k] = (rnd_unit() < 0.6 ? -1 : 1) * mag;
-            if (rnd_unit() < 0.05) *d[k] = NAN;
-            truth[k] = *d[k];
+            double v = (rnd_unit() < 0.6 ? -1 : 1) * mag;
+            if (rnd_unit() < 0.05) v = NAN;
+            if (k == 0) { /* the time: whole microseconds up to 10^16 s (beyond the range: any int64) */
+                j->t_takeoff_us = isnan(v) ? GS_T_NONE : fabs(v) < 9.2e12 ? (int64_t)llround(v * 1e6)
+                                                                          : v < 0 ? -INT64_MAX : INT64_MAX;
+                v = gs_time_s_of_us(j->t_takeoff_us);
+            } else {
+                *d[k] = v;
+            }
+            truth[k] = v;
         }
         j->n_samples = rnd_unit() < 0.3 ? UINT32_MAX : (uint32_t)(rnd_unit() * 1000);
         n = gs_emit_nmea(&e, buf, sizeof buf);
@@ -675,7 +712,8 @@ void test_json_widest_events_fit(void)
     e.type = GS_EV_JUMP;
     gs_ev_jump *j = &e.u.jump;
     j->track = j->index = j->n_samples = j->n_outliers = UINT32_MAX;
-    j->t_takeoff_s = j->t_land_s = j->flight_time_s = j->t_apex_s = F;
+    j->t_takeoff_us = j->t_land_us = j->t_apex_us = INT64_MIN + 1; /* the widest time */
+    j->flight_time_s = F;
     j->a_px_s2 = j->a_px_se_s2 = j->q_m_per_px = S;
     j->g_dir_deg = j->size_px = j->height_m = j->height_se_m = j->jump_height_m = F;
     j->takeoff_velocity_m_s = j->rms_px = F;
@@ -683,7 +721,7 @@ void test_json_widest_events_fit(void)
     j->reason = GS_REJ_IMPLAUSIBLE_A;
     j->warnings = 0xFFu;
     size_t n = gs_emit_json(&e, buf, sizeof buf);
-    TEST_ASSERT_EQUAL_UINT64(744, n);
+    TEST_ASSERT_EQUAL_UINT64(738, n); /* its three times at their widest are 2 characters narrower than F */
     jv v[32];
     TEST_ASSERT_TRUE_MESSAGE(json_line(buf, v, 32) > 0, buf);
 
@@ -693,7 +731,8 @@ void test_json_widest_events_fit(void)
     s->track = s->session = s->n_jumps = s->n_rejected = UINT32_MAX;
     s->ended = true;
     s->reason = "end_of_stream";
-    s->t_start_s = s->t_end_s = s->stature_m = s->ci95_lo_m = s->ci95_hi_m = F;
+    s->t_start_us = s->t_end_us = INT64_MIN + 1;
+    s->stature_m = s->ci95_lo_m = s->ci95_hi_m = F;
     s->best_jump_m = s->mean_jump_m = s->best_flight_s = s->mean_flight_s = s->mean_takeoff_velocity_m_s = F;
     n = gs_emit_json(&e, buf, sizeof buf);
     TEST_ASSERT_TRUE(n > 0 && n < GS_EMIT_MAX);

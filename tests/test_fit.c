@@ -10,6 +10,10 @@
 #include <stdio.h>
 #include <string.h>
 
+/* seconds to the fit's microseconds (GS_T_NONE for NaN), and a span snapped to them */
+#define US(t_s) gs_time_us_of_s(t_s)
+#define SNAP(t_s) ((double)US(t_s) / 1e6)
+
 void setUp(void) {}
 void tearDown(void) {}
 
@@ -185,6 +189,7 @@ static double g_max_rel_dev; /* reported at the end */
 static void test_stream_matches_batch_reference(void)
 {
     static double t[MAXN], x[MAXN], y[MAXN], w[MAXN];
+    static int64_t t_us[MAXN];
     int trial;
     double worst = 0.0;
     rng_seed(12345);
@@ -206,7 +211,7 @@ static void test_stream_matches_batch_reference(void)
         }
         for (i = 0; i < n; i++) {
             double tt = rng_range(0.0, dur);
-            t[i] = tstart + tt;
+            t_us[i] = US(tstart + tt);
             x[i] = x0 + vx * tt + 0.5 * ax * tt * tt + sigma * rng_gauss();
             y[i] = y0 + vy * tt + 0.5 * ay * tt * tt + sigma * rng_gauss();
             w[i] = rng_unif() < 0.05 ? 0.0 : rng_range(0.05, 1.0);
@@ -216,15 +221,16 @@ static void test_stream_matches_batch_reference(void)
                 w[i] = rng_range(0.05, 1.0); /* keep at least 4 weighted samples */
             }
         }
-        gs_fit_init(&f, t[0], tscale);
+        gs_fit_init(&f, t_us[0], US(tscale));
         for (i = 0; i < n; i++) {
-            gs_fit_add(&f, t[i], x[i], y[i], w[i]);
+            gs_fit_add(&f, t_us[i], x[i], y[i], w[i]);
+            t[i] = (double)(t_us[i] - t_us[0]) / 1e6; /* the reference on the same times, exactly */
         }
-        ref = ref_fit(n, t, x, y, w, t[0]);
+        ref = ref_fit(n, t, x, y, w, 0.0);
         TEST_ASSERT_TRUE(ref.ok);
         TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&f, &res));
         TEST_ASSERT_EQUAL_UINT32(ref.n, res.n);
-        TEST_ASSERT_EQUAL_DOUBLE(t[0], res.t0_s);
+        TEST_ASSERT_TRUE(res.t0_us == t_us[0]);
         /* Natural magnitudes of each quantity over the window (x is offset by t - t[0] up to dur). */
         acc_scale = ref.a;
         vel_scale = fabs(ref.vx) + fabs(ref.vy) + acc_scale * dur;
@@ -265,10 +271,10 @@ static void test_stream_extreme_tscale_exact(void)
         gs_fit_result res;
         uint32_t i, n = 120;
         double dur = 1.0, tstart = 86400.0 * 1.3;
-        gs_fit_init(&f, tstart, ratios[k] * dur);
+        gs_fit_init(&f, US(tstart), US(ratios[k] * dur));
         for (i = 0; i < n; i++) {
-            double tt = dur * i / (n - 1);
-            gs_fit_add(&f, tstart + tt, 640.0 + 40.0 * tt - 5.0 * tt * tt, 200.0 - 900.0 * tt + 490.5 * tt * tt, 1.0);
+            double tt = SNAP(dur * i / (n - 1));
+            gs_fit_add(&f, US(tstart + tt), 640.0 + 40.0 * tt - 5.0 * tt * tt, 200.0 - 900.0 * tt + 490.5 * tt * tt, 1.0);
         }
         TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&f, &res));
         TEST_ASSERT_DOUBLE_WITHIN(1e-9 * 981.0, -10.0, res.ax_px_s2);
@@ -292,14 +298,14 @@ static void fit_rolled(double roll_deg, gs_fit_result *res)
     double c = cos(th), s = sin(th);
     gs_fit f;
     int i;
-    gs_fit_init(&f, 1e5, 0.8);
+    gs_fit_init(&f, US(1e5), US(0.8));
     for (i = 0; i < 97; i++) {
-        double tt = i / 120.0;
+        double tt = SNAP(i / 120.0);
         double lx = 3.0 * tt, ly = -450.0 * tt + 490.0 * tt * tt; /* level-camera motion */
         /* Rotating the level frame by th maps image-down (0,1) to (sin th, cos th). */
         double xi = 500.0 + c * lx + s * ly;
         double yi = 300.0 - s * lx + c * ly;
-        gs_fit_add(&f, 1e5 + tt, xi, yi, 1.0);
+        gs_fit_add(&f, US(1e5 + tt), xi, yi, 1.0);
     }
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&f, res));
 }
@@ -333,10 +339,10 @@ static void test_three_samples_exact_without_se(void)
     gs_fit f;
     gs_fit_result res;
     int i;
-    gs_fit_init(&f, 10.0, 0.1);
+    gs_fit_init(&f, US(10.0), US(0.1));
     for (i = 0; i < 3; i++) {
         double tt = 0.05 * i;
-        gs_fit_add(&f, 10.0 + tt, 1.0 + 2.0 * tt, 5.0 + 3.0 * tt + 0.5 * 700.0 * tt * tt, 0.5 + 0.2 * i);
+        gs_fit_add(&f, US(10.0 + tt), 1.0 + 2.0 * tt, 5.0 + 3.0 * tt + 0.5 * 700.0 * tt * tt, 0.5 + 0.2 * i);
     }
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&f, &res));
     TEST_ASSERT_EQUAL_UINT32(3, res.n);
@@ -359,15 +365,15 @@ static void se_monte_carlo(int weighted, double *ratio_out, double *cover_out)
         gs_fit f;
         gs_fit_result res;
         uint32_t i;
-        gs_fit_init(&f, 5000.0, 1.0);
+        gs_fit_init(&f, US(5000.0), US(1.0));
         for (i = 0; i < n; i++) {
-            double tt = i / 60.0;
+            double tt = SNAP(i / 60.0);
             /* Noise SD sigma/sqrt(w): the weights are correct relative inverse variances. */
             double w = weighted ? rng_range(0.2, 1.0) : 1.0;
             double sd = sigma / sqrt(w);
             double x = 300.0 + 20.0 * tt + 0.5 * ax * tt * tt + sd * rng_gauss();
             double y = 700.0 - 450.0 * tt + 0.5 * ay * tt * tt + sd * rng_gauss();
-            gs_fit_add(&f, 5000.0 + tt, x, y, w);
+            gs_fit_add(&f, US(5000.0 + tt), x, y, w);
         }
         TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&f, &res));
         sum += res.a_px_s2;
@@ -410,7 +416,7 @@ static gs_sample ring_store[RING_CAP];
 static gs_sample_full mk_sample(double t, double x, double y, double w)
 {
     gs_sample_full s;
-    s.t_s = t;
+    s.t_us = US(t);
     s.x_px = (float)x;
     s.y_px = (float)y;
     s.w = (float)w;
@@ -422,16 +428,16 @@ static gs_sample_full mk_sample(double t, double x, double y, double w)
 }
 
 /* Plain gs_fit over ring samples with their own weights, reported at t0. */
-static gs_status direct_fit(const gs_ring *r, uint64_t first, uint32_t count, double t0, const float *wts,
+static gs_status direct_fit(const gs_ring *r, uint64_t first, uint32_t count, int64_t t0_us, const float *wts,
                             gs_fit_result *res)
 {
     gs_fit f;
     uint32_t i;
-    gs_fit_init(&f, t0, 0.37);
+    gs_fit_init(&f, t0_us, 370000);
     for (i = 0; i < count; i++) {
         gs_sample_full s;
         TEST_ASSERT_TRUE(gs_ring_get(r, first + i, &s));
-        gs_fit_add(&f, s.t_s, s.x_px, s.y_px, wts ? wts[i] : s.w);
+        gs_fit_add(&f, s.t_us, s.x_px, s.y_px, wts ? wts[i] : s.w);
     }
     return gs_fit_solve(&f, res);
 }
@@ -474,9 +480,9 @@ static void test_ring_window_across_wrap(void)
         TEST_ASSERT_TRUE(gs_fit_kept(w, i)); /* plain LS keeps every weighted sample */
     }
     TEST_ASSERT_EQUAL_UINT32(60, res.n);
-    TEST_ASSERT_EQUAL_INT(GS_OK, direct_fit(&r, 40, 60, res.t0_s, NULL, &direct));
-    /* t0 is the window's middle (the ring keeps whole microseconds). */
-    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 3600.0 + (40.0 + 99.0) / 2.0 / 120.0, res.t0_s);
+    TEST_ASSERT_EQUAL_INT(GS_OK, direct_fit(&r, 40, 60, res.t0_us, NULL, &direct));
+    /* t0 is the window's middle, floored to the microsecond */
+    TEST_ASSERT_TRUE(res.t0_us == (US(3600.0 + 40.0 / 120.0) + US(3600.0 + 99.0 / 120.0)) / 2);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * 1500.0, direct.a_px_s2, res.a_px_s2);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * 1000.0, direct.y0_px, res.y0_px);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * 1000.0, direct.vy_px_s, res.vy_px_s);
@@ -613,7 +619,7 @@ static void run_outlier_case(const outlier_case *oc)
             TEST_ASSERT_TRUE(gs_ring_get(&r, 30 + i, &s));
             wts[i] = gs_fit_kept(w, i) ? s.w : 0.0f;
         }
-        TEST_ASSERT_EQUAL_INT(GS_OK, direct_fit(&r, 30, n, ransac.t0_s, wts, &again));
+        TEST_ASSERT_EQUAL_INT(GS_OK, direct_fit(&r, 30, n, ransac.t0_us, wts, &again));
         TEST_ASSERT_DOUBLE_WITHIN(1e-9 * a_true, again.a_px_s2, ransac.a_px_s2);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, again.y0_px, ransac.y0_px);
     }
@@ -728,9 +734,9 @@ static void test_degenerate_table(void)
         gs_ring r;
         static uint32_t wbuf[1];
         uint32_t i;
-        gs_fit_init(&f, 0.0, 1.0);
+        gs_fit_init(&f, US(0.0), US(1.0));
         for (i = 0; i < c->n; i++) {
-            gs_fit_add(&f, c->t[i], c->x[i], c->y[i], c->w[i]);
+            gs_fit_add(&f, US(c->t[i]), c->x[i], c->y[i], c->w[i]);
         }
         st = gs_fit_solve(&f, &res);
         TEST_ASSERT_EQUAL_INT_MESSAGE(c->want, st, c->name);
@@ -772,22 +778,22 @@ static void test_nan_inputs_are_ignored(void)
     gs_fit a, b;
     gs_fit_result ra, rb;
     int i;
-    gs_fit_init(&a, 50.0, 0.5);
-    gs_fit_init(&b, 50.0, 0.5);
+    gs_fit_init(&a, US(50.0), US(0.5));
+    gs_fit_init(&b, US(50.0), US(0.5));
     rng_seed(8);
     for (i = 0; i < 40; i++) {
         double tt = 50.0 + i / 30.0;
         double x = 100.0 + 3.0 * i + rng_gauss(), y = 200.0 + 0.4 * i * i + rng_gauss();
-        gs_fit_add(&a, tt, x, y, 1.0);
-        gs_fit_add(&b, tt, x, y, 1.0);
+        gs_fit_add(&a, US(tt), x, y, 1.0);
+        gs_fit_add(&b, US(tt), x, y, 1.0);
         /* Interleave junk into b only. */
-        gs_fit_add(&b, NAN, x, y, 1.0);
-        gs_fit_add(&b, tt, NAN, y, 1.0);
-        gs_fit_add(&b, tt, x, INFINITY, 1.0);
-        gs_fit_add(&b, tt, x + 500.0, y, NAN);
-        gs_fit_add(&b, tt, x + 500.0, y, 0.0);
-        gs_fit_add(&b, tt, x + 500.0, y, -1.0);
-        gs_fit_add(&b, tt, x + 500.0, y, INFINITY);
+        gs_fit_add(&b, US(NAN), x, y, 1.0);
+        gs_fit_add(&b, US(tt), NAN, y, 1.0);
+        gs_fit_add(&b, US(tt), x, INFINITY, 1.0);
+        gs_fit_add(&b, US(tt), x + 500.0, y, NAN);
+        gs_fit_add(&b, US(tt), x + 500.0, y, 0.0);
+        gs_fit_add(&b, US(tt), x + 500.0, y, -1.0);
+        gs_fit_add(&b, US(tt), x + 500.0, y, INFINITY);
     }
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&a, &ra));
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&b, &rb));
@@ -800,10 +806,58 @@ static void test_nan_inputs_are_ignored(void)
     TEST_ASSERT_EQUAL_MEMORY(&ra.g_dir_deg, &rb.g_dir_deg, sizeof ra.g_dir_deg);
     TEST_ASSERT_EQUAL_MEMORY(&ra.rms_px, &rb.rms_px, sizeof ra.rms_px);
     /* NULL arguments never crash. */
-    gs_fit_init(NULL, 0.0, 1.0);
-    gs_fit_add(NULL, 0.0, 1.0, 1.0, 1.0);
+    gs_fit_init(NULL, 0, 1000000);
+    gs_fit_add(NULL, 0, 1.0, 1.0, 1.0);
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_fit_solve(NULL, &ra));
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_fit_solve(&a, NULL));
+}
+
+/* A bad centre becomes 0, a bad scale 1 s; an unknown time is ignored; times at the
+ * limits of the range neither overflow nor change the fit of the others. */
+static void test_init_and_add_limits(void)
+{
+    static const struct { int64_t t0_us, tscale_us, want_t0_us; double want_tscale_s; } rows[] = {
+        {5000000, 250000, 5000000, 0.25},
+        {-7, 1, -7, 1e-6},
+        {GS_T_MAX_US, 2147483647, GS_T_MAX_US, 2147.483647},
+        {-GS_T_MAX_US, 1000000, -GS_T_MAX_US, 1.0},
+        {GS_T_NONE, 1000000, 0, 1.0},
+        {GS_T_MAX_US + 1, 1000000, 0, 1.0},
+        {INT64_MAX, 0, 0, 1.0},
+        {3, 0, 3, 1.0},
+        {3, -5, 3, 1.0},
+        {3, GS_T_NONE, 3, 1.0},
+    };
+    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
+        gs_fit f;
+        gs_fit_init(&f, rows[k].t0_us, rows[k].tscale_us);
+        TEST_ASSERT_TRUE_MESSAGE(f.t0_us == rows[k].want_t0_us, "t0 row");
+        TEST_ASSERT_DOUBLE_WITHIN(1e-12 * rows[k].want_tscale_s, rows[k].want_tscale_s, f.tscale_s);
+        TEST_ASSERT_EQUAL_UINT32(0, f.n);
+    }
+    /* a parabola sampled every 10 ms, centred far from zero; junk times interleaved */
+    gs_fit a, b;
+    gs_fit_result ra, rb;
+    const int64_t t0 = GS_T_MAX_US - 1000000;
+    gs_fit_init(&a, t0, 500000);
+    gs_fit_init(&b, t0, 500000);
+    for (int i = 0; i < 50; i++) {
+        double tt = 0.01 * (i - 25);
+        int64_t t = t0 + (int64_t)(i - 25) * 10000;
+        gs_fit_add(&a, t, 3.0 * tt, 100.0 - 200.0 * tt + 490.0 * tt * tt, 1.0);
+        gs_fit_add(&b, t, 3.0 * tt, 100.0 - 200.0 * tt + 490.0 * tt * tt, 1.0);
+        gs_fit_add(&b, GS_T_NONE, 1e6, 1e6, 1.0);
+    }
+    gs_fit_add(&a, -GS_T_MAX_US, 0.0, 0.0, 1e-300);  /* 2^63 us from the centre: no overflow, no effect */
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&a, &ra));
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_solve(&b, &rb));
+    TEST_ASSERT_EQUAL_UINT32(51, ra.n);
+    TEST_ASSERT_EQUAL_UINT32(50, rb.n);
+    TEST_ASSERT_TRUE(rb.t0_us == t0);
+    TEST_ASSERT_DOUBLE_WITHIN(980.0 * 1e-9, 980.0, rb.ay_px_s2);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, -200.0, rb.vy_px_s);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 3.0, rb.vx_px_s);
+    TEST_ASSERT_DOUBLE_WITHIN(980.0 * 1e-6, 980.0, ra.ay_px_s2);
 }
 
 static void test_robust_nan_samples_and_bad_args(void)
@@ -832,7 +886,7 @@ static void test_robust_nan_samples_and_bad_args(void)
     TEST_ASSERT_FALSE(gs_fit_kept(w, 30));
     TEST_ASSERT_FALSE(gs_fit_kept(w, 31));
     TEST_ASSERT_TRUE(gs_fit_kept(w, 32));
-    TEST_ASSERT_EQUAL_INT(GS_OK, direct_fit(&r, 0, 62, res.t0_s, NULL, &ref));
+    TEST_ASSERT_EQUAL_INT(GS_OK, direct_fit(&r, 0, 62, res.t0_us, NULL, &ref));
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * 981.0, ref.a_px_s2, res.a_px_s2);
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_robust(&r, 0, 62, GS_FIT_IRLS, 0.5f, w, &res));
     TEST_ASSERT_EQUAL_UINT32(60, res.n);
@@ -894,6 +948,7 @@ int main(void)
     RUN_TEST(test_stream_extreme_tscale_exact);
     RUN_TEST(test_exact_parabola_and_g_direction);
     RUN_TEST(test_three_samples_exact_without_se);
+    RUN_TEST(test_init_and_add_limits);
     RUN_TEST(test_se_calibration);
     RUN_TEST(test_ring_window_across_wrap);
     RUN_TEST(test_window_partly_overwritten_is_einval);

@@ -124,6 +124,7 @@ typedef struct {
 static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(double) + 8];
 
 static gs_jump_judge_fn g_judge; /* the front end's judge for run_from (NULL: none) */
+static int64_t g_clock_us;       /* run_from's clock: sample time t is g_clock_us + t, in microseconds */
 static void run_from(const sim_track *s, const cam *c, capture *cap, double t_begin, double t_end);
 static void run(const sim_track *s, const cam *c, capture *cap, double t_end) { run_from(s, c, cap, 0.0, t_end); }
 
@@ -152,8 +153,8 @@ static void run_from(const sim_track *s, const cam *c, capture *cap, double t_be
         yi += c->noise_px * nrand();
         if (urand() < c->outlier_rate) { xi += 40.0 * (urand() - 0.5) * 2.0; yi += 40.0 * (urand() - 0.5) * 2.0; }
         cap->now = t;
-        TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, t, (float)xi, (float)yi, 1.0f,
-                                                        (float)(size_px + 0.3 * c->noise_px * nrand())));
+        TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point_us(&p, g_clock_us + gs_time_us_of_s(t), (float)xi, (float)yi,
+                                                           1.0f, (float)(size_px + 0.3 * c->noise_px * nrand())));
     }
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
     TEST_ASSERT_EQUAL(1, cap->n_summary);
@@ -168,7 +169,7 @@ static int match_tol(const sim_track *s, const capture *cap, int *map, double to
         for (int e = 0; e < cap->n_jumps; e++) {
             const gs_ev_jump *j = &cap->jumps[e];
             if (!j->accepted) continue;
-            if (fabs(j->t_takeoff_s - s->jumps[k].t_takeoff) < tol_s && fabs(j->t_land_s - s->jumps[k].t_land) < tol_s) {
+            if (fabs(gs_time_s_of_us(j->t_takeoff_us) - s->jumps[k].t_takeoff) < tol_s && fabs(gs_time_s_of_us(j->t_land_us) - s->jumps[k].t_land) < tol_s) {
                 map[k] = e;
                 found++;
                 break;
@@ -205,8 +206,8 @@ static void test_exact_track_30fps(void)
     for (int k = 0; k < 4; k++) {
         const gs_ev_jump *j = &cap.jumps[map[k]];
         TEST_ASSERT_DOUBLE_WITHIN(0.003 * a_true, a_true, j->a_px_s2);
-        TEST_ASSERT_DOUBLE_WITHIN(0.5 / 30.0, s.jumps[k].t_takeoff, j->t_takeoff_s);
-        TEST_ASSERT_DOUBLE_WITHIN(0.5 / 30.0, s.jumps[k].t_land, j->t_land_s);
+        TEST_ASSERT_DOUBLE_WITHIN(0.5 / 30.0, s.jumps[k].t_takeoff, gs_time_s_of_us(j->t_takeoff_us));
+        TEST_ASSERT_DOUBLE_WITHIN(0.5 / 30.0, s.jumps[k].t_land, gs_time_s_of_us(j->t_land_us));
         TEST_ASSERT_DOUBLE_WITHIN(0.003 * 0.20, 0.20, j->height_m);
         double v0 = s.jumps[k].v0;
         TEST_ASSERT_DOUBLE_WITHIN(0.03 * v0, v0, j->takeoff_velocity_m_s);
@@ -269,8 +270,8 @@ static void test_noisy_rolled(void)
         TEST_ASSERT_TRUE(j->a_px_se_s2 < 0.06 * a_true);
         double dir_se_deg = j->a_px_se_s2 / j->a_px_s2 * 57.2958;
         TEST_ASSERT_DOUBLE_WITHIN(3.0 * dir_se_deg + 0.5, 30.0, j->g_dir_deg);
-        d0[k] = fabs(j->t_takeoff_s - s.jumps[k].t_takeoff);
-        d1[k] = fabs(j->t_land_s - s.jumps[k].t_land);
+        d0[k] = fabs(gs_time_s_of_us(j->t_takeoff_us) - s.jumps[k].t_takeoff);
+        d1[k] = fabs(gs_time_s_of_us(j->t_land_us) - s.jumps[k].t_land);
     }
     TEST_ASSERT_TRUE(median5(d0, 5) < 1.0 / 30.0);
     TEST_ASSERT_TRUE(median5(d1, 5) < 1.0 / 30.0);
@@ -292,8 +293,8 @@ static void test_120fps(void)
         const gs_ev_jump *j = &cap.jumps[map[k]];
         TEST_ASSERT_DOUBLE_WITHIN(3.0 * j->a_px_se_s2 + 0.002 * a_true, a_true, j->a_px_s2);
         TEST_ASSERT_TRUE(j->a_px_se_s2 < 0.025 * a_true);  /* theory: 1.3 % for the 0.25 s flight */
-        TEST_ASSERT_DOUBLE_WITHIN(2.0 / 120.0, s.jumps[k].t_takeoff, j->t_takeoff_s);
-        TEST_ASSERT_DOUBLE_WITHIN(2.0 / 120.0, s.jumps[k].t_land, j->t_land_s);
+        TEST_ASSERT_DOUBLE_WITHIN(2.0 / 120.0, s.jumps[k].t_takeoff, gs_time_s_of_us(j->t_takeoff_us));
+        TEST_ASSERT_DOUBLE_WITHIN(2.0 / 120.0, s.jumps[k].t_land, gs_time_s_of_us(j->t_land_us));
     }
 }
 
@@ -405,8 +406,8 @@ static void test_hours_across_time_wraps(void)
         const gs_ev_jump *j = &cap.jumps[map[k]], *r = &cap_ref.jumps[map_ref[k]];
         TEST_ASSERT_DOUBLE_WITHIN(1e-6 * r->a_px_s2, r->a_px_s2, j->a_px_s2);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, r->height_m, j->height_m);
-        TEST_ASSERT_DOUBLE_WITHIN(1e-5, r->t_takeoff_s, j->t_takeoff_s);
-        TEST_ASSERT_DOUBLE_WITHIN(1e-5, r->t_land_s, j->t_land_s);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, gs_time_s_of_us(r->t_takeoff_us), gs_time_s_of_us(j->t_takeoff_us));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, gs_time_s_of_us(r->t_land_us), gs_time_s_of_us(j->t_land_us));
         TEST_ASSERT_EQUAL_UINT32(r->n_samples, j->n_samples);
         TEST_ASSERT_DOUBLE_WITHIN(0.003 * 0.20, 0.20, j->height_m);
     }
@@ -454,14 +455,49 @@ static void test_pause_beyond_time_span(void)
         TEST_ASSERT_EQUAL_INT(near.n_jumps, far.n_jumps);
         for (int e = 0; e < near.n_jumps; e++) {
             const gs_ev_jump *a = &near.jumps[e], *b = &far.jumps[e];
-            double sh = a->t_takeoff_s > 5.0 ? 2990.0 : 0.0;
+            double sh = gs_time_s_of_us(a->t_takeoff_us) > 5.0 ? 2990.0 : 0.0;
             TEST_ASSERT_EQUAL_INT(a->accepted, b->accepted);
             TEST_ASSERT_EQUAL_UINT32(a->n_samples, b->n_samples);
             TEST_ASSERT_EQUAL_UINT32(a->warnings, b->warnings);
             TEST_ASSERT_DOUBLE_WITHIN(1e-6 * fabs(a->a_px_s2) + 1e-9, a->a_px_s2, b->a_px_s2);
-            TEST_ASSERT_DOUBLE_WITHIN(1e-4, a->t_takeoff_s + sh, b->t_takeoff_s);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-4, gs_time_s_of_us(a->t_takeoff_us) + sh, gs_time_s_of_us(b->t_takeoff_us));
         }
     }
+}
+
+/* Only time differences count: the same noisy stream on a clock 54 years later (Unix
+ * time in microseconds) or before zero gives the same flights, to the bit, with every
+ * time shifted by exactly the offset. */
+static void test_clock_offset_invariance(void)
+{
+    static const int64_t offsets_us[] = {INT64_C(1700000000000000), -INT64_C(86400000000), GS_T_MAX_US / 2};
+    sim_track s;
+    make_track(&s, 3, 1.5, 2.5, 1.6, 2.4);
+    cam c = {120.0, 0.004, 3.0, 0.4, 0.20, 0.01, 0.21};
+    static capture ref, cap;
+    rng_state = 99;
+    g_clock_us = 0;
+    run(&s, &c, &ref, 9.0);
+    TEST_ASSERT_EQUAL_INT(3, ref.n_jumps);
+    for (size_t k = 0; k < sizeof offsets_us / sizeof offsets_us[0]; k++) {
+        rng_state = 99;
+        g_clock_us = offsets_us[k];
+        run(&s, &c, &cap, 9.0);
+        TEST_ASSERT_EQUAL_INT(ref.n_jumps, cap.n_jumps);
+        for (int e = 0; e < ref.n_jumps; e++) {
+            const gs_ev_jump *a = &ref.jumps[e], *b = &cap.jumps[e];
+            TEST_ASSERT_TRUE(a->t_takeoff_us + offsets_us[k] == b->t_takeoff_us);
+            TEST_ASSERT_TRUE(a->t_land_us + offsets_us[k] == b->t_land_us);
+            TEST_ASSERT_TRUE(a->t_apex_us + offsets_us[k] == b->t_apex_us);
+            TEST_ASSERT_EQUAL_MEMORY(&a->flight_time_s, &b->flight_time_s, sizeof a->flight_time_s);
+            TEST_ASSERT_EQUAL_MEMORY(&a->a_px_s2, &b->a_px_s2, sizeof a->a_px_s2);
+            TEST_ASSERT_EQUAL_MEMORY(&a->height_m, &b->height_m, sizeof a->height_m);
+            TEST_ASSERT_EQUAL_MEMORY(&a->jump_height_m, &b->jump_height_m, sizeof a->jump_height_m);
+            TEST_ASSERT_EQUAL_UINT32(a->n_samples, b->n_samples);
+            TEST_ASSERT_EQUAL_UINT32(a->n_outliers, b->n_outliers);
+        }
+    }
+    g_clock_us = 0;
 }
 
 static void test_bad_calls(void)
@@ -476,6 +512,12 @@ static void test_bad_calls(void)
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point(&p, 1.0, 1, 1, 1, NAN));
     TEST_ASSERT_EQUAL(GS_EORDER, gs_pipeline_push_point(&p, 0.5, 1, 1, 1, NAN));
     TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_push_point(&p, NAN, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_push_point(&p, INFINITY, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_ERANGE, gs_pipeline_push_point(&p, 1e300, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_push_point_us(&p, GS_T_NONE, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_ERANGE, gs_pipeline_push_point_us(&p, GS_T_MAX_US + 1, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_EORDER, gs_pipeline_push_point_us(&p, 999999, 1, 1, 1, NAN));
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_point_us(&p, 1000000, 1, 1, 1, NAN));  /* the same frame again */
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
     TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_push_point(&p, 2.0, 1, 1, 1, NAN));
     TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_flush(&p));
@@ -493,6 +535,7 @@ int main(void)
     RUN_TEST(test_ring_smaller_than_a_flight);
     RUN_TEST(test_hours_across_time_wraps);
     RUN_TEST(test_pause_beyond_time_span);
+    RUN_TEST(test_clock_offset_invariance);
     RUN_TEST(test_bad_calls);
     return UNITY_END();
 }

@@ -479,6 +479,92 @@ void test_fmt_fixed_table(void)
     TEST_ASSERT_EQUAL(0, gs_num_fmt_fixed(buf, sizeof buf, 1.0, -1));
 }
 
+/* microseconds as seconds: exact digits, ties half away from zero, sign symmetric */
+void test_fmt_us_table(void)
+{
+    static const struct { int64_t t_us; int d; const char *want; } c[] = {
+        {0, 0, "0"},          {0, 4, "0.0000"},       {0, 9, "0.000000000"},
+        {1, 6, "0.000001"},   {-1, 6, "-0.000001"},   {1, 5, "0.00000"},     {5, 5, "0.00001"},
+        {-5, 5, "-0.00001"},  {-4, 5, "0.00000"},     {500000, 0, "1"},      {499999, 0, "0"},
+        {-500000, 0, "-1"},   {-499999, 0, "0"},      {1500000, 0, "2"},     {2500000, 0, "3"},
+        {-2500000, 0, "-3"},  {12345679, 4, "12.3457"}, {12345650, 4, "12.3457"}, {12345649, 4, "12.3456"},
+        {-12345650, 4, "-12.3457"}, {999999500, 3, "1000.000"}, {-999999500, 3, "-1000.000"},
+        {1234567, 9, "1.234567000"}, {-1234567, 7, "-1.2345670"}, {33333, 4, "0.0333"},
+        {86400000000, 3, "86400.000"}, {4611686018427387904, 4, "4611686018427.3879"},
+        {-4611686018427387904, 6, "-4611686018427.387904"}, {INT64_MAX, 0, "9223372036855"},
+        {INT64_MAX, 6, "9223372036854.775807"}, {INT64_MIN + 1, 9, "-9223372036854.775807000"},
+        {INT64_MIN + 1, 2, "-9223372036854.78"},
+    };
+    char buf[64];
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        size_t n = gs_num_fmt_us(buf, sizeof buf, c[i].t_us, c[i].d);
+        TEST_ASSERT_EQUAL_STRING_MESSAGE(c[i].want, buf, c[i].want);
+        TEST_ASSERT_EQUAL(strlen(c[i].want), n);
+    }
+    /* unknown, or no such format: 0 and "" */
+    strcpy(buf, "xx");
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_us(buf, sizeof buf, INT64_MIN, 3));
+    TEST_ASSERT_EQUAL_STRING("", buf);
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_us(buf, sizeof buf, 1, 10));
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_us(buf, sizeof buf, 1, -1));
+    TEST_ASSERT_EQUAL(0, gs_num_fmt_us(NULL, 0, 1, 2));
+    /* the exact size: all or nothing, never past cap */
+    for (size_t cap = 0; cap <= 8; cap++) {
+        char b[16];
+        memset(b, 0xA5, sizeof b);
+        size_t n = gs_num_fmt_us(b, cap, -1234567, 4); /* "-1.2346": 7 characters and the NUL */
+        TEST_ASSERT_EQUAL(cap == 8 ? 7u : 0u, n);
+        for (size_t k = cap; k < sizeof b; k++) TEST_ASSERT_EQUAL_HEX8(0xA5, (uint8_t)b[k]);
+        if (cap) TEST_ASSERT_EQUAL_STRING(cap == 8 ? "-1.2346" : "", b);
+    }
+}
+
+/* the reference: integer arithmetic with printf; and gs_num_fmt_fixed of t / 1e6 away from ties */
+void test_fmt_us_random(void)
+{
+    uint64_t st = 0x1234567887654321ull;
+    char got[64], want[80], fx[64];
+    int n_fixed = 0;
+    for (int it = 0; it < 200000; it++) {
+        st ^= st << 13;
+        st ^= st >> 7;
+        st ^= st << 17;
+        int d = (int)(st % 10u);
+        int64_t t;
+        switch ((st >> 8) % 4u) {
+        case 0: t = (int64_t)(st >> 1) * ((st >> 5) & 1u ? -1 : 1); break; /* any magnitude */
+        case 1: t = (int64_t)((st >> 12) % 2000000000000ull) - 1000000000000; break; /* +-11.6 days */
+        case 2: t = (int64_t)((st >> 12) % 20000001u) - 10000000; break;
+        default: t = ((int64_t)((st >> 12) % 2001u) - 1000) * 50; break; /* many exact ties */
+        }
+        if (t == INT64_MIN) continue;
+        uint64_t mag = t < 0 ? (uint64_t)-t : (uint64_t)t;
+        uint64_t scale = 1;
+        for (int k = d; k < 6; k++) scale *= 10u;
+        uint64_t q = d >= 6 ? mag : mag / scale, r = d >= 6 ? 0 : mag % scale;
+        bool tie = d < 6 && 2u * r == scale;
+        if (d < 6 && 2u * r >= scale) q++;
+        uint64_t p10 = 1;
+        for (int k = 0; k < (d < 6 ? d : 6); k++) p10 *= 10u;
+        int len = snprintf(want, sizeof want, "%s%llu", (q && t < 0) ? "-" : "", (unsigned long long)(q / p10));
+        if (d > 0) {
+            len += snprintf(want + len, sizeof want - (size_t)len, ".%0*llu", d < 6 ? d : 6, (unsigned long long)(q % p10));
+            for (int k = 6; k < d; k++) want[len++] = '0';
+            want[len] = '\0';
+        }
+        size_t n = gs_num_fmt_us(got, sizeof got, t, d);
+        TEST_ASSERT_EQUAL_STRING_MESSAGE(want, got, want);
+        TEST_ASSERT_EQUAL((size_t)len, n);
+        /* the text the double-seconds format gave for the same time: equal except at exact ties */
+        if (!tie && d <= 6 && mag < 1000000000000000ull) { /* beyond 6 decimals the double has other digits */
+            gs_num_fmt_fixed(fx, sizeof fx, (double)t / 1e6, d);
+            TEST_ASSERT_EQUAL_STRING_MESSAGE(fx, got, fx);
+            n_fixed++;
+        }
+    }
+    printf("fmt_us random: 200000 times equal to the integer reference; %d equal to gs_num_fmt_fixed(t / 1e6)\n", n_fixed);
+}
+
 void test_fmt_fixed_random_vs_libc(void)
 {
     char got[64], want[64], libc[64];
@@ -648,6 +734,8 @@ int main(void)
     RUN_TEST(test_parse_int_table);
     RUN_TEST(test_fmt_fixed_table);
     RUN_TEST(test_fmt_fixed_random_vs_libc);
+    RUN_TEST(test_fmt_us_table);
+    RUN_TEST(test_fmt_us_random);
     RUN_TEST(test_fmt_sig_table);
     RUN_TEST(test_fmt_sig_random);
     RUN_TEST(test_fmt_sig_near_max);

@@ -28,7 +28,7 @@ void tearDown(void) {}
 static gs_sample_full mk(uint64_t i)
 {
     gs_sample_full s;
-    s.t_s = (double)i;
+    s.t_us = (int64_t)i;  /* one microsecond apart: the index is the time */
     s.x_px = (float)(i % 65536u);
     s.y_px = (float)((i * 7u) % 65536u);
     s.w = 1.0f;
@@ -59,7 +59,7 @@ static void assert_window(uint64_t oldest, uint64_t head)
         gs_sample_full s;
         TEST_ASSERT_NOT_NULL(gs_ring_at(&g_r, i));
         TEST_ASSERT_TRUE(gs_ring_get(&g_r, i, &s));
-        TEST_ASSERT_TRUE(s.t_s == (double)i);
+        TEST_ASSERT_TRUE(s.t_us == (int64_t)i);
         TEST_ASSERT_EQUAL_FLOAT((float)(i % 65536u), s.x_px);
     }
     TEST_ASSERT_NULL(gs_ring_at(&g_r, head));
@@ -159,17 +159,17 @@ static void test_at_returns_null_for_evicted_and_future(void)
     TEST_ASSERT_NOT_NULL(gs_ring_at(&g_r, CAP + 3u));
     TEST_ASSERT_NULL(gs_ring_at(&g_r, CAP + 4u));
     /* The evicted index 3 and the held index 3+CAP share a slot: only the held one resolves. */
-    TEST_ASSERT_TRUE(gs_ring_sample_t_s(&g_r, gs_ring_at(&g_r, CAP + 3u)) == (double)(CAP + 3u));
+    TEST_ASSERT_TRUE(gs_ring_sample_t_us(&g_r, gs_ring_at(&g_r, CAP + 3u)) == (int64_t)(CAP + 3u));
 }
 
 static void test_push_copies_sample(void)
 {
     gs_sample_full s = mk(42);
     gs_ring_push(&g_r, &s);
-    s.t_s = -1.0;  /* the caller's copy changes, the ring's does not */
+    s.t_us = -1;  /* the caller's copy changes, the ring's does not */
     gs_sample_full g;
     TEST_ASSERT_TRUE(gs_ring_get(&g_r, 0, &g));
-    TEST_ASSERT_TRUE(g.t_s == 42.0);
+    TEST_ASSERT_TRUE(g.t_us == 42);
     TEST_ASSERT_TRUE(isnan(g.size_px));
     TEST_ASSERT_FALSE(gs_ring_get(&g_r, 1, &g));
 }
@@ -179,7 +179,7 @@ static void test_push_copies_sample(void)
 static gs_sample_full roundtrip(float size_px, float w, float upright)
 {
     gs_sample_full s = mk(gs_ring_head(&g_r)), out;
-    s.t_s = (double)gs_ring_head(&g_r);
+    s.t_us = (int64_t)gs_ring_head(&g_r);
     s.size_px = size_px;
     s.w = w;
     s.upright = upright;
@@ -249,59 +249,63 @@ static void test_body_axis_newest_only(void)
 
 /* ---- time: microseconds modulo 2^32 around the newest sample ------------------------------ */
 
-static void push_t(double t)
+static void push_t(int64_t t_us)
 {
     gs_sample_full s = mk(gs_ring_head(&g_r));
-    s.t_s = t;
+    s.t_us = t_us;
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
 }
 
-/* Every held sample reads back its own time, in whole microseconds since base. */
-static void assert_times(double base, const double *t, uint64_t n_pushed)
+/* Every held sample reads back its own time, exactly. */
+static void assert_times(const int64_t *t, uint64_t n_pushed)
 {
     for (uint64_t i = gs_ring_oldest(&g_r); i < gs_ring_head(&g_r); i++) {
         gs_sample_full o;
         TEST_ASSERT_TRUE(gs_ring_get(&g_r, i, &o));
-        double want = base + (double)(int64_t)((t[i % n_pushed] - base) * 1e6 + 0.5) / 1e6;
-        TEST_ASSERT_DOUBLE_WITHIN(1e-9 * (1.0 + fabs(want)), want, o.t_s);
+        TEST_ASSERT_TRUE(o.t_us == t[i % n_pushed]);
+        TEST_ASSERT_TRUE(gs_ring_sample_t_us(&g_r, gs_ring_at(&g_r, i)) == t[i % n_pushed]);
     }
 }
+
+#define S_US INT64_C(1000000)
+#define MIN_US (60 * S_US)
 
 /* A daemon runs for hours: the 32-bit microsecond field wraps every 71.6 min. Start
  * just before the wrap (as ring tests of RTOS kernels do) and cross it three times. */
 static void test_time_wraps_every_71_minutes(void)
 {
-    static double t[CAP];
-    const double base = 1.0e5 + 0.123456;  /* a boot clock far from zero */
-    const double wrap_s = 4294.967296;
+    static int64_t t[CAP];
+    const int64_t base = 100000 * S_US + 123456;  /* a boot clock far from zero */
+    const int64_t wrap_us = INT64_C(1) << 32;
     push_t(base);
     t[0] = base;
     /* minute steps up to just before the first wrap: the ring spans 16 min */
     uint64_t n = 1;
-    for (double u = 60.0; u < wrap_s - 0.5; u += 60.0, n++) {
+    for (int64_t u = MIN_US; u < wrap_us - S_US / 2; u += MIN_US, n++) {
         t[n % CAP] = base + u;
         push_t(base + u);
     }
     for (int lap = 0; lap < 3; lap++) {
-        double w0 = base + wrap_s * (lap + 1);
-        /* 1 ms frames (plus a jittered fraction) across the wrap point */
+        int64_t w0 = base + wrap_us * (lap + 1);
+        /* 1 ms frames (plus a jittered microsecond) across the wrap point */
         for (int k = -40; k < 40; k++, n++) {
-            double tk = w0 + k * 1e-3 + (k % 3) * 1.7e-7;
+            int64_t tk = w0 + k * 1000 + (k % 3);
             t[n % CAP] = tk;
             push_t(tk);
-            assert_times(base, t, CAP);
+            assert_times(t, CAP);
         }
         /* differences inside the ring are exact through the wrap */
         gs_sample_full a, b;
         TEST_ASSERT_TRUE(gs_ring_get(&g_r, n - 1u, &b));
         TEST_ASSERT_TRUE(gs_ring_get(&g_r, n - CAP, &a));
-        TEST_ASSERT_DOUBLE_WITHIN(2e-6, (double)(CAP - 1u) * 1e-3, b.t_s - a.t_s);
+        TEST_ASSERT_TRUE(b.t_us - a.t_us == t[(n - 1u) % CAP] - t[(n - CAP) % CAP]);
+        TEST_ASSERT_INT64_WITHIN(2, (int64_t)(CAP - 1u) * 1000, b.t_us - a.t_us);
         /* minutes to the next lap */
-        for (double u = 60.0; u < wrap_s - 60.0; u += 60.0, n++) {
+        for (int64_t u = MIN_US; u < wrap_us - MIN_US; u += MIN_US, n++) {
             t[n % CAP] = w0 + u;
             push_t(w0 + u);
         }
-        assert_times(base, t, CAP);
+        assert_times(t, CAP);
     }
     TEST_ASSERT_TRUE(gs_ring_count(&g_r) == CAP);
 }
@@ -309,50 +313,75 @@ static void test_time_wraps_every_71_minutes(void)
 /* Samples 2^31 us (35.8 min) older than the newest leave the ring, as if overwritten. */
 static void test_time_span_evicts(void)
 {
-    push_t(0.0);
-    push_t(1.0);
-    push_t(1200.0);          /* 20 min */
+    push_t(0);
+    push_t(1 * S_US);
+    push_t(1200 * S_US);     /* 20 min */
     TEST_ASSERT_EQUAL_UINT32(3, gs_ring_count(&g_r));
-    push_t(2147.0);          /* the first two are 2146 s old: still inside */
+    push_t(2147 * S_US);     /* the first two are 2146 s old: still inside */
     TEST_ASSERT_EQUAL_UINT32(4, gs_ring_count(&g_r));
-    push_t(2149.0);          /* now 0.0 and 1.0 are past 2147.48 s */
+    push_t(GS_RING_SPAN_US - 1);  /* 0 is one microsecond short of the span: still inside */
+    TEST_ASSERT_EQUAL_UINT32(5, gs_ring_count(&g_r));
+    push_t(GS_RING_SPAN_US);      /* exactly the span: 0 leaves, 1 s stays */
+    TEST_ASSERT_EQUAL_UINT64(1, gs_ring_oldest(&g_r));
+    push_t(2149 * S_US);     /* now 1 s is past 2147.48 s */
     TEST_ASSERT_EQUAL_UINT64(2, gs_ring_oldest(&g_r));
     TEST_ASSERT_NULL(gs_ring_at(&g_r, 1));
     gs_sample_full o;
     TEST_ASSERT_TRUE(gs_ring_get(&g_r, 2, &o));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1200.0, o.t_s);
-    push_t(2149.0 + 40.0 * 60.0);  /* a 40 min pause: nothing before it can be told apart */
+    TEST_ASSERT_TRUE(o.t_us == 1200 * S_US);
+    push_t(2149 * S_US + 40 * MIN_US);  /* a 40 min pause: nothing before it can be told apart */
     TEST_ASSERT_EQUAL_UINT32(1, gs_ring_count(&g_r));
     TEST_ASSERT_TRUE(gs_ring_get(&g_r, gs_ring_head(&g_r) - 1u, &o));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 4549.0, o.t_s);
-    push_t(4 * 3600.0);           /* hours later, across a wrap */
-    push_t(4 * 3600.0 + 0.5);
+    TEST_ASSERT_TRUE(o.t_us == 4549 * S_US);
+    push_t(4 * 3600 * S_US);      /* hours later, across a wrap */
+    push_t(4 * 3600 * S_US + S_US / 2);
     TEST_ASSERT_EQUAL_UINT32(2, gs_ring_count(&g_r));
     TEST_ASSERT_TRUE(gs_ring_get(&g_r, gs_ring_oldest(&g_r), &o));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 14400.0, o.t_s);
+    TEST_ASSERT_TRUE(o.t_us == 14400 * S_US);
 }
 
 static void test_time_order_and_bad_times(void)
 {
     gs_sample_full s = mk(0);
-    s.t_s = 5.0;
+    s.t_us = 5 * S_US;
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
     TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));       /* equal: stored */
-    s.t_s = 5.0 - 2e-6;
+    s.t_us = 5 * S_US - 1;
     TEST_ASSERT_EQUAL_INT(GS_EORDER, gs_ring_push(&g_r, &s));
-    s.t_s = 5.0 - 4e-7;                                           /* the same microsecond */
-    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
-    s.t_s = NAN;
+    s.t_us = GS_T_NONE;
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, &s));
-    s.t_s = INFINITY;
+    s.t_us = GS_T_MAX_US + 1;                                     /* beyond 2^62 us */
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, &s));
-    s.t_s = 1e13;                                                 /* 2^62 us from the base and beyond */
+    s.t_us = INT64_MAX;
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, &s));
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(NULL, &s));
     TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&g_r, NULL));
-    TEST_ASSERT_EQUAL_UINT32(3, gs_ring_count(&g_r));
-    TEST_ASSERT_TRUE(gs_ring_time_us(&g_r, 6.5) == 1500000);
-    TEST_ASSERT_TRUE(gs_ring_time_us(&g_r, NAN) == INT64_MIN);
+    TEST_ASSERT_EQUAL_UINT32(2, gs_ring_count(&g_r));
+    s.t_us = GS_T_MAX_US;                                         /* the largest time is stored */
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
+    TEST_ASSERT_EQUAL_UINT32(1, gs_ring_count(&g_r));              /* far beyond the span */
+    TEST_ASSERT_TRUE(gs_ring_get(&g_r, gs_ring_head(&g_r) - 1u, &s));
+    TEST_ASSERT_TRUE(s.t_us == GS_T_MAX_US);
+    /* the two ends of the accepted range, 2^63 us apart: the newer is stored, reads back
+     * exactly, and nothing older is held (far beyond the span) */
+    gs_ring r;
+    gs_sample_full b = mk(0), o_full;
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_init(&r, &g_mem[1], CAP));
+    static const int64_t ends[] = {-GS_T_MAX_US, -GS_T_MAX_US + 1, GS_T_MAX_US - 1, GS_T_MAX_US};
+    for (size_t k = 0; k < sizeof ends / sizeof ends[0]; k++) {
+        b.t_us = ends[k];
+        TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&r, &b));
+        TEST_ASSERT_EQUAL_UINT32(k % 2u ? 2u : 1u, gs_ring_count(&r));  /* 1 us after the one before: both held */
+        TEST_ASSERT_TRUE(gs_ring_get(&r, gs_ring_head(&r) - 1u, &o_full));
+        TEST_ASSERT_TRUE(o_full.t_us == ends[k]);
+    }
+    TEST_ASSERT_TRUE(gs_ring_get(&r, gs_ring_oldest(&r), &o_full));
+    TEST_ASSERT_TRUE(o_full.t_us == GS_T_MAX_US - 1);
+    b.t_us = GS_T_MAX_US - 2;
+    TEST_ASSERT_EQUAL_INT(GS_EORDER, gs_ring_push(&r, &b));
+    b.t_us = INT64_MIN + 1;
+    TEST_ASSERT_EQUAL_INT(GS_EINVAL, gs_ring_push(&r, &b));
+    setUp();  /* g_mem served r */
 }
 
 int main(void)

@@ -29,16 +29,17 @@ typedef struct {
     const char *want_reason;
 } frame_case;
 
-static void run_cases(const frame_case *c, size_t n)
+static void run_cases_absence(const frame_case *c, size_t n, int64_t absence_us)
 {
     gs_session s;
-    gs_session_init(&s, 2.5, 0.12);
+    gs_session_init(&s, absence_us, 0.12);
     for (size_t i = 0; i < n; i++) {
         const char *why = NULL, *why2 = NULL;
-        uint32_t r = gs_session_frame(&s, c[i].t_s, c[i].present, c[i].stand_px, &why);
+        int64_t t_us = gs_time_us_of_s(c[i].t_s);
+        uint32_t r = gs_session_frame(&s, t_us, c[i].present, c[i].stand_px, &why);
         if (r & GS_SESSION_ENDED) {  /* as the pipeline does: close, and a body in view starts the next */
             gs_session_close(&s);
-            if (c[i].present) r |= gs_session_frame(&s, c[i].t_s, true, NAN, &why2);
+            if (c[i].present) r |= gs_session_frame(&s, t_us, true, NAN, &why2);
         }
         char msg[64];
         snprintf(msg, sizeof msg, "case row %u (t %.2f)", (unsigned)i, c[i].t_s);
@@ -49,6 +50,8 @@ static void run_cases(const frame_case *c, size_t n)
             TEST_ASSERT_NULL_MESSAGE(why, msg);
     }
 }
+
+static void run_cases(const frame_case *c, size_t n) { run_cases_absence(c, n, 2500000); }
 
 void test_absence_ends_and_return_starts(void)
 {
@@ -63,6 +66,53 @@ void test_absence_ends_and_return_starts(void)
         {4.0, true, NAN, GS_SESSION_STARTED, NULL},
     };
     run_cases(c, sizeof c / sizeof c[0]);
+}
+
+/* The limits are whole microseconds: an absence of exactly 2.5 s ends, 1 us less does not;
+ * an unknown time is ignored. */
+void test_absence_limit_exact(void)
+{
+    gs_session s;
+    gs_session_init(&s, 2500000, 0.12);
+    TEST_ASSERT_TRUE(s.gap_us == 500000);  /* a gap: 0.5 s, or the absence when shorter */
+    TEST_ASSERT_EQUAL_UINT32(GS_SESSION_STARTED, gs_session_frame(&s, 200000, true, NAN, NULL));
+    TEST_ASSERT_EQUAL_UINT32(0, gs_session_frame(&s, GS_T_NONE, false, NAN, NULL));
+    const char *why = "junk";
+    TEST_ASSERT_EQUAL_UINT32(0, gs_session_frame(&s, 2699999, false, NAN, &why));
+    TEST_ASSERT_NULL(why);
+    TEST_ASSERT_EQUAL_UINT32(GS_SESSION_ENDED, gs_session_frame(&s, 2700000, false, NAN, &why));
+    TEST_ASSERT_EQUAL_STRING("absence", why);
+    gs_session_close(&s);
+    TEST_ASSERT_EQUAL_UINT32(GS_SESSION_STARTED, gs_session_frame(&s, -GS_T_MAX_US, true, NAN, NULL));
+    TEST_ASSERT_TRUE(s.t_start_us == -GS_T_MAX_US);
+    TEST_ASSERT_EQUAL_UINT32(GS_SESSION_ENDED, gs_session_frame(&s, GS_T_MAX_US, false, NAN, &why));
+    static const struct { int64_t absence_us, gap_us; } gaps[] = {
+        {0, 0}, {1, 1}, {300000, 300000}, {499999, 499999}, {500000, 500000}, {500001, 500000}, {600000000, 500000},
+    };
+    for (size_t k = 0; k < sizeof gaps / sizeof gaps[0]; k++) {
+        gs_session_init(&s, gaps[k].absence_us, 0.12);
+        TEST_ASSERT_TRUE_MESSAGE(s.gap_us == gaps[k].gap_us, "gap row");
+        TEST_ASSERT_TRUE(s.t_start_us == GS_T_NONE && s.t_seen_us == GS_T_NONE && isnan(s.ref_px));
+    }
+}
+
+/* With an absence shorter than 0.5 s the gap is the absence: a body seen again after
+ * exactly 0.3 s (and a new size) is someone else; after 0.3 s - 1 us it is not. */
+void test_gap_is_the_shorter_absence(void)
+{
+    for (int k = 0; k < 2; k++) {
+        gs_session s;
+        gs_session_init(&s, 300000, 0.12);
+        int64_t t = 0;
+        TEST_ASSERT_EQUAL_UINT32(GS_SESSION_STARTED, gs_session_frame(&s, t, true, NAN, NULL));
+        for (int i = 0; i < (int)GS_SESSION_REF_N; i++) gs_session_frame(&s, t += 33333, true, 400.0, NULL);
+        t += k ? 300000 : 299999;
+        uint32_t r = 0;
+        const char *why = NULL;
+        for (int i = 0; i < 6; i++, t += 33333) r |= gs_session_frame(&s, t, true, 320.0, &why);
+        TEST_ASSERT_EQUAL_UINT32(k ? GS_SESSION_ENDED : 0u, r);
+        if (k) TEST_ASSERT_EQUAL_STRING("new_body", why);
+    }
 }
 
 void test_other_size_after_gap_is_a_new_body(void)
@@ -242,8 +292,8 @@ void test_ball_has_no_sessions(void)
 void test_session_lines(void)
 {
     gs_session s;
-    gs_session_init(&s, 2.5, 0.12);
-    gs_session_frame(&s, 1.5, true, NAN, NULL);
+    gs_session_init(&s, 2500000, 0.12);
+    gs_session_frame(&s, 1500000, true, NAN, NULL);
     gs_ev_jump j;
     memset(&j, 0, sizeof j);
     j.accepted = true;
@@ -257,7 +307,7 @@ void test_session_lines(void)
     gs_session_jump(&s, &j);
     j.accepted = false;
     gs_session_jump(&s, &j);
-    gs_session_frame(&s, 9.25, true, NAN, NULL);
+    gs_session_frame(&s, 9250000, true, NAN, NULL);
     gs_ev_height h = {0, 1.7512, 1.7301, 1.7723, 2, 1};
     gs_event ev;
     gs_session_event(&s, true, "absence", &h, 0, &ev);
@@ -280,6 +330,8 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_absence_ends_and_return_starts);
+    RUN_TEST(test_absence_limit_exact);
+    RUN_TEST(test_gap_is_the_shorter_absence);
     RUN_TEST(test_other_size_after_gap_is_a_new_body);
     RUN_TEST(test_size_change_in_view_or_small_is_the_same_body);
     RUN_TEST(test_pipeline_two_people);

@@ -190,7 +190,7 @@ int main(int argc, char **argv)
     memset(&ev, 0, sizeof ev);
     ev.type = GS_EV_JUMP;
     gs_ev_jump *j = &ev.u.jump;
-    j->t_takeoff_s = 2.6926, j->t_land_s = 3.3411, j->flight_time_s = 0.6485, j->t_apex_s = 3.0099;
+    j->t_takeoff_us = 2692600, j->t_land_us = 3341100, j->flight_time_s = 0.6485, j->t_apex_us = 3009900;
     j->a_px_s2 = 3109.01, j->a_px_se_s2 = 14.74, j->g_dir_deg = -0.31, j->q_m_per_px = 0.00315535;
     j->size_px = 549.86, j->height_m = 1.735, j->height_se_m = 0.0085, j->jump_height_m = 0.4938;
     j->takeoff_velocity_m_s = 3.113, j->n_samples = 19, j->n_outliers = 1, j->rms_px = 1.116;

@@ -13,8 +13,8 @@
 # A device selection (include/gravscale/gs_features.h, docs/firmware.md):
 #   GS_FW_DEVICE=all (default: every feature, the profile parsed from text)
 #     | ball-lab (point input, NMEA, profile baked at build time, no trace events, no ransac)
-#     | camera-coco17 | camera-blazepose33 (that skeleton layout, NMEA, parsed profile,
-#       no trace events, no ransac)
+#     | camera-coco17 | camera-blazepose33 (that skeleton layout, NMEA, profile baked at
+#       build time, no trace events, no ransac)
 #   GS_FW_FEATURES="GS_WITH_JSON=0 GS_WITH_BLAZEPOSE33=0"  features left out (overrides the device's)
 #   GS_FW_PROFILE=OFF  the profile baked at build time (tools/fw/fw_bake.c: parsed and checked
 #     on the host, no text parser linked) instead of its text parsed at boot
@@ -41,8 +41,10 @@ case ${GS_FW_DEVICE:-all} in
   all) ;;
   ball-lab) dev_features="GS_WITH_JSON=0 GS_WITH_COCO17=0 GS_WITH_BLAZEPOSE33=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
             dev_profile=OFF ;;
-  camera-coco17) dev_features="GS_WITH_JSON=0 GS_WITH_BLAZEPOSE33=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0" ;;
-  camera-blazepose33) dev_features="GS_WITH_JSON=0 GS_WITH_COCO17=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0" ;;
+  camera-coco17) dev_features="GS_WITH_JSON=0 GS_WITH_BLAZEPOSE33=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
+                 dev_profile=OFF ;;
+  camera-blazepose33) dev_features="GS_WITH_JSON=0 GS_WITH_COCO17=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
+                      dev_profile=OFF ;;
   *) echo "firmware_size: unknown GS_FW_DEVICE '$GS_FW_DEVICE' (all, ball-lab, camera-coco17, camera-blazepose33)" >&2; exit 2 ;;
 esac
 features=${GS_FW_FEATURES:-$dev_features}

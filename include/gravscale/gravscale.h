@@ -3,6 +3,7 @@
 #define GRAVSCALE_H
 
 #include "gs_types.h"
+#include "gs_time.h"
 #include "gs_num.h"
 #include "gs_ring.h"
 #include "gs_com.h"

@@ -17,7 +17,7 @@ typedef struct {
 } gs_agg;
 
 void gs_agg_init(gs_agg *a);
-void gs_agg_add(gs_agg *a, double value_m, double se_m);
+void gs_agg_add(gs_agg *a, gs_real value_m, gs_real se_m);
 void gs_agg_reject(gs_agg *a);
 /* Fill height_m, ci95_lo_m, ci95_hi_m, n_jumps, n_rejected; NaN when nothing accepted. */
 void gs_agg_get(const gs_agg *a, gs_ev_height *out);

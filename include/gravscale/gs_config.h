@@ -40,9 +40,9 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
 
 /* The [core] section. */
 typedef struct {
-    double g_m_s2;             /* g; NaN = from latitude/altitude when set, else 9.81 */
-    double latitude_deg;       /* NaN unset */
-    double altitude_m;         /* 0 default */
+    gs_real g_m_s2;            /* g; NaN = from latitude/altitude when set, else 9.81 */
+    gs_real latitude_deg;      /* NaN unset */
+    gs_real altitude_m;        /* 0 default */
     gs_mass_table mass_table;  /* mass_table = deleva|clauser|dempster */
     gs_stature_method stature; /* stature = anthro|nose_ankle_1.17 */
     float min_conf;            /* keypoints below count as missing (0..1) */
@@ -68,9 +68,9 @@ gs_status gs_core_config_set(void *ctx, const char *key, size_t key_len,
 /* Cross-field checks after parsing (e.g. min_flight_s < max_flight_s). */
 gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err);
 /* The g in force: g_m_s2 if set, else from latitude/altitude, else 9.81. */
-double gs_core_config_g(const gs_core_config *c);
+gs_real gs_core_config_g(const gs_core_config *c);
 
 /* Normal gravity (WGS-84 Somigliana formula) with the free-air altitude correction. */
-double gs_gravity_m_s2(double latitude_deg, double altitude_m);
+gs_real gs_gravity_m_s2(gs_real latitude_deg, gs_real altitude_m);
 
 #endif

@@ -1,8 +1,10 @@
-/* gs_event.h - what the core reports. Unknown values are NaN (emitted as null). */
+/* gs_event.h - what the core reports. Unknown values are NaN, unknown times GS_T_NONE
+ * (both emitted as null). Times are microseconds (gs_time.h), printed as seconds. */
 #ifndef GS_EVENT_H
 #define GS_EVENT_H
 
 #include "gs_types.h"
+#include "gs_time.h"
 
 typedef enum {
     GS_EV_START = 0, /* written by the program that owns the source (it knows the fps) */
@@ -44,7 +46,7 @@ const char *gs_reject_reason_name(gs_reject_reason r);
 typedef struct {
     const char *version;
     const char *config;       /* config file name or "default" */
-    double fps_source;        /* NaN unknown */
+    gs_real fps_source;       /* NaN unknown */
     const char *fps_origin;   /* "timestamps", "container", "metadata", "cli", ... or NULL */
     const char *layout;       /* layout name or NULL */
 } gs_ev_start;
@@ -52,13 +54,14 @@ typedef struct {
 typedef struct {
     uint32_t track;           /* 0 unless several objects are tracked */
     uint32_t index;           /* 0-based flight counter of the run */
-    double t_takeoff_s, t_land_s, flight_time_s, t_apex_s;
-    double a_px_s2, a_px_se_s2, g_dir_deg, q_m_per_px;
-    double size_px;           /* pixel size used (standing stature, ball diameter) */
-    double height_m, height_se_m;
-    double jump_height_m, takeoff_velocity_m_s;
+    int64_t t_takeoff_us, t_land_us, t_apex_us;  /* GS_T_NONE unknown */
+    gs_real flight_time_s;
+    gs_real a_px_s2, a_px_se_s2, g_dir_deg, q_m_per_px;
+    gs_real size_px;          /* pixel size used (standing stature, ball diameter) */
+    gs_real height_m, height_se_m;
+    gs_real jump_height_m, takeoff_velocity_m_s;
     uint32_t n_samples, n_outliers;
-    double rms_px;
+    gs_real rms_px;
     bool accepted;
     gs_reject_reason reason;
     uint32_t warnings;        /* GS_WARN_* bits */
@@ -66,7 +69,7 @@ typedef struct {
 
 typedef struct {
     uint32_t track;
-    double height_m, ci95_lo_m, ci95_hi_m;
+    gs_real height_m, ci95_lo_m, ci95_hi_m;
     uint32_t n_jumps, n_rejected;
 } gs_ev_height;  /* also the summary */
 
@@ -75,32 +78,32 @@ typedef struct {
     uint32_t session;          /* 1-based visit number */
     bool ended;                /* false: it started */
     const char *reason;        /* end: "absence", "new_body", "end_of_stream"; NULL at the start */
-    double t_start_s, t_end_s; /* t_end_s NaN at the start */
-    double stature_m, ci95_lo_m, ci95_hi_m;   /* the visit's aggregate, NaN unknown */
+    int64_t t_start_us, t_end_us; /* t_end_us GS_T_NONE at the start */
+    gs_real stature_m, ci95_lo_m, ci95_hi_m;   /* the visit's aggregate, NaN unknown */
     uint32_t n_jumps, n_rejected;
-    double best_jump_m, mean_jump_m, best_flight_s, mean_flight_s, mean_takeoff_velocity_m_s;
+    gs_real best_jump_m, mean_jump_m, best_flight_s, mean_flight_s, mean_takeoff_velocity_m_s;
 } gs_ev_session;
 
 typedef struct {
     uint32_t track;
-    double t_s;
-    uint32_t warnings;         /* GS_WARN_* bits that started at t_s */
+    int64_t t_us;
+    uint32_t warnings;         /* GS_WARN_* bits that started at t_us */
 } gs_ev_warning;
 
 typedef struct {
-    double t_s;
+    int64_t t_us;
     const char *from, *to;
 } gs_ev_state;
 
 typedef struct {
-    double t_s;
+    int64_t t_us;
     float x_px, y_px, w, size_px, upright;
 } gs_ev_sample;
 
 typedef struct {
-    double t_first_s, t_last_s;
+    int64_t t_first_us, t_last_us;
     uint32_t n;
-    double a_px_s2, g_dir_deg, rms_px;
+    gs_real a_px_s2, g_dir_deg, rms_px;
     const char *purpose;      /* e.g. "flight", "extend", "final" */
 } gs_ev_fit;
 

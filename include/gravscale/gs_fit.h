@@ -8,7 +8,8 @@
 #include "gs_ring.h"
 
 typedef struct {
-    double t0_s, tscale_s;  /* double: t0 is an absolute time */
+    int64_t t0_us;         /* centre of the time axis */
+    gs_real tscale_s;      /* its unit, seconds */
     gs_real r[6];          /* upper triangle of R, row-major: r00 r01 r02 r11 r12 r22 */
     gs_real zx[3], zy[3];  /* Q^T * sqrt(w) * x and y */
     gs_real ssr_x, ssr_y;  /* weighted residual sum of squares */
@@ -17,7 +18,7 @@ typedef struct {
 } gs_fit;
 
 typedef struct {
-    double t0_s;              /* reference time of the coefficients */
+    int64_t t0_us;            /* reference time of the coefficients */
     gs_real x0_px, vx_px_s, ax_px_s2;  /* x(t) = x0 + vx*(t-t0) + ax/2*(t-t0)^2 */
     gs_real y0_px, vy_px_s, ay_px_s2;
     gs_real a_px_s2;          /* |(ax, ay)| */
@@ -27,11 +28,11 @@ typedef struct {
     uint32_t n;
 } gs_fit_result;
 
-/* Start an empty fit. t0_s: a time inside the expected window (e.g. the first
- * sample); tscale_s > 0: about the window's length. */
-void gs_fit_init(gs_fit *f, double t0_s, double tscale_s);
+/* Start an empty fit. t0_us: a time inside the expected window (e.g. its
+ * centre); tscale_us > 0: about the window's length. */
+void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us);
 /* Add one sample with weight w >= 0 (w == 0 or non-finite values are ignored). */
-void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w);
+void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w);
 /* Solve. GS_EINVAL when fewer than 3 weighted samples or the design is singular
  * (e.g. fewer than 3 distinct times). With exactly 3 the exact parabola is
  * returned and a_se_px_s2 is NaN (no degrees of freedom). */

@@ -31,12 +31,14 @@ typedef struct {
     bool trace;
     bool rigid;                /* object size is measured in every frame (ball), not while standing */
     uint32_t track;            /* reported in every event (several objects: one pipeline each) */
-    gs_real g_m_s2;            /* gs_real here and below; times stay double (gs_flight.c says why) */
+    gs_real g_m_s2;
+    /* the configured spans in microseconds (gs_time_us_of_cfg_s) */
+    int64_t min_flight_us, max_flight_us, max_gap_us, landing_latency_us;
 
     gs_flight_state state;
     uint64_t next;             /* next ring index to examine */
     uint64_t quiet_from;       /* first index after the last closed candidate */
-    double last_t_s;           /* time of the last valid sample, NaN none */
+    int64_t last_t_us;         /* time of the last valid sample, GS_T_NONE none */
     uint64_t last_idx;
 
     gs_real up_x, up_y;        /* image direction against gravity (unit) */
@@ -48,14 +50,14 @@ typedef struct {
     uint32_t noise_n;
     gs_real u_hist[3];         /* last three u of valid samples (for a median of 3) */
     uint64_t i_hist[3];
-    double t_hist[3];
+    int64_t t_hist_us[3];
     uint32_t n_hist;
 
     gs_real blk_min_cur, blk_min_prev; /* running minimum of u over the last ~0.5-1 s */
-    double blk_t0;
+    int64_t blk_t0_us;
     gs_real peak_u;            /* running maximum once the rise is significant */
     uint64_t peak_idx;
-    double peak_t;
+    int64_t peak_t_us;
 
     /* the open flight candidate */
     gs_fit fit;                /* streaming fit of the accepted in-flight samples */
@@ -64,14 +66,14 @@ typedef struct {
     gs_real cusum;             /* one-sided CUSUM of the deviation against gravity */
     uint32_t pend_ok;          /* bit k: pending sample fl_last+1+k is no gross outlier */
     uint32_t outliers_run;     /* consecutive gross outliers */
-    double dt_med_s;           /* typical frame interval (double: frame counts are taken from it) */
+    uint32_t dt_med_q4;        /* typical frame interval in 1/16 us, 0 unknown (integer: frame counts are taken from it) */
 
     float stand_size[GS_STAND_KEEP];
     uint32_t stand_n, stand_next;
     float loose_size[GS_STAND_KEEP]; /* still, roughly upright frames: a fallback */
     uint32_t loose_n, loose_next;
-    double stand_last_t;
-    double still_since;        /* start of the current still, upright stretch, NaN none */
+    int64_t stand_last_us;     /* time of the newest standing size, GS_T_NONE none */
+    int64_t still_since_us;    /* start of the current still, upright stretch, GS_T_NONE none */
 
     gs_real last_a_px_s2;      /* last accepted acceleration, NaN none */
     gs_real last_g_dir_deg;
@@ -88,8 +90,8 @@ void gs_flight_update(gs_flight *f);
 void gs_flight_break(gs_flight *f);
 /* End of stream: close any open candidate. */
 void gs_flight_finish(gs_flight *f);
-/* The standing size this sample added (NaN when the sample at t_s was no still, upright frame). */
-double gs_flight_stand_at(const gs_flight *f, double t_s);
+/* The standing size this sample added (NaN when the sample at t_us was no still, upright frame). */
+gs_real gs_flight_stand_at(const gs_flight *f, int64_t t_us);
 /* Someone else: forget the standing sizes (and the body axis) learnt so far. */
 void gs_flight_forget_body(gs_flight *f);
 

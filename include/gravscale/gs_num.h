@@ -29,6 +29,13 @@ bool gs_num_parse_int(const char *s, size_t len, long *out);
  * or cap is too small (buf then holds ""). */
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals);
 
+/* Format t_us microseconds as seconds with exactly `decimals` (0..9) digits after
+ * the point, rounded half away from zero (exact: from the integer's decimal digits),
+ * "-0.000" printed as "0.000". Writes a NUL. Returns chars written (without the NUL),
+ * or 0 when t_us is INT64_MIN (GS_T_NONE, gs_time.h) or cap is too small (buf then
+ * holds ""). */
+size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals);
+
 /* Format a finite v with `sig` (1..15) significant digits, in plain notation
  * when 1e-4 <= |v| < 1e15, otherwise as d.ddde-XX; trailing zeros trimmed.
  * Rounded half away from zero, except where that would exceed the double range

@@ -28,7 +28,7 @@ typedef struct {
     void *ctx;
     gs_jump_judge_fn judge;    /* NULL: none */
     void *judge_ctx;
-    double last_t_s;
+    int64_t last_t_us;         /* GS_T_NONE before the first frame */
     uint64_t n_frames;
     bool finished;
 } gs_pipeline;
@@ -48,10 +48,17 @@ void gs_pipeline_set_judge(gs_pipeline *p, gs_jump_judge_fn fn, void *ctx);
 /* Also emit GS_EV_STATE / GS_EV_SAMPLE / GS_EV_FIT trace events. */
 void gs_pipeline_set_trace(gs_pipeline *p, bool on);
 
-/* One frame of keypoints (gs_layout_kp_count(layout) of them). t_s must not
- * decrease (GS_EORDER, sample dropped); equal times are dropped silently. */
-gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp);
+/* One frame of keypoints (gs_layout_kp_count(layout) of them) at t_us
+ * microseconds. t_us must not decrease (GS_EORDER, sample dropped); equal
+ * times are dropped silently; GS_EINVAL for GS_T_NONE, GS_ERANGE beyond
+ * GS_T_MAX_US. */
+gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp);
 /* One frame of a tracked point (GS_LAYOUT_POINT) with its size (NaN unknown). */
+gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, float y_px,
+                                    float c, float size_px);
+/* The same with t_s in seconds (hosts), rounded to the microsecond
+ * (gs_time_us_of_s): GS_EINVAL when not finite. */
+gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp);
 gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px,
                                  float c, float size_px);
 /* End of stream: finish open flights and emit GS_EV_SUMMARY. Further pushes: GS_ESTATE. */

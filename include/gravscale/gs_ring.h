@@ -1,8 +1,8 @@
 /* gs_ring.h - fixed-capacity ring of 16-byte gs_sample in caller storage. Oldest
  * samples are overwritten when full; absolute sample indices keep counting so
  * that a flight window can be addressed as [first, first+count). Times are kept
- * as microseconds since a time base (the first sample's time) modulo 2^32 and
- * are read back relative to the newest sample, so the 32-bit field may wrap
+ * as their microseconds modulo 2^32 and read back relative to the newest
+ * sample's (kept whole), so the 32-bit field may wrap
  * (every 71.6 min) at any point: the ring holds only samples less than
  * GS_RING_SPAN_US older than the newest (older ones leave it as if
  * overwritten), and a time difference inside it is always exact. */
@@ -10,6 +10,7 @@
 #define GS_RING_H
 
 #include "gs_types.h"
+#include "gs_time.h"
 
 /* Samples this much older than the newest leave the ring (2^31 us = 35.8 min). */
 #define GS_RING_SPAN_US 2147483648LL
@@ -20,8 +21,7 @@ typedef struct {
     uint32_t mask;
     uint64_t head;       /* absolute index of the next sample to write */
     uint64_t valid_from; /* samples before this index fell out of the time span */
-    double t_base_s;     /* time base of t_us (the first sample's time), NaN before it */
-    int64_t t_last_us;   /* newest sample's time since the base */
+    int64_t t_last_us;   /* newest sample's time, GS_T_NONE before the first */
     float last_up_x, last_up_y;  /* newest sample's body axis (not kept per sample) */
 } gs_ring;
 
@@ -32,13 +32,10 @@ typedef struct {
 
 /* capacity must be a power of two >= 8. */
 gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity);
-/* Store s (packed). GS_EINVAL: NULL or a non-finite time or one more than
- * 2^62 us from the base; GS_EORDER: s is older than the newest sample (whole
- * microseconds; an equal time is stored). */
+/* Store s (packed). GS_EINVAL: NULL or a time that is not gs_time_ok (GS_T_NONE,
+ * beyond GS_T_MAX_US); GS_EORDER: s is older than the newest sample (an equal
+ * time is stored). */
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s);
-/* Microseconds since the time base that t_s would be stored as (the first
- * sample sets the base); INT64_MIN when not representable. */
-int64_t gs_ring_time_us(const gs_ring *r, double t_s);
 /* Absolute index of the oldest sample still held (== head when empty). */
 uint64_t gs_ring_oldest(const gs_ring *r);
 uint64_t gs_ring_head(const gs_ring *r);
@@ -49,7 +46,7 @@ const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i);
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out);
 
 /* Field accessors of a held sample (s from gs_ring_at of the same ring). */
-double gs_ring_sample_t_s(const gs_ring *r, const gs_sample *s);
+int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s);  /* absolute */
 float gs_sample_w(const gs_sample *s);
 float gs_sample_size_px(const gs_sample *s);  /* NaN unknown */
 float gs_sample_upright(const gs_sample *s);  /* NaN unknown */

@@ -11,20 +11,20 @@
 #define GS_SESSION_REF_N 8u  /* standing frames that fix a session's reference size */
 
 typedef struct {
-    double absence_s;        /* no body for this long ends the session */
-    double new_body_rel;     /* after a gap, a standing size this far (relative) from the reference: new body */
-    double gap_s;            /* an absence at least this long counts as a gap for the size test */
+    int64_t absence_us;      /* no body for this long ends the session */
+    gs_real new_body_rel;    /* after a gap, a standing size this far (relative) from the reference: new body */
+    int64_t gap_us;          /* an absence at least this long counts as a gap for the size test */
 
     uint32_t id;             /* last session number, 1-based; 0 before the first */
     bool open;
-    double t_start_s, t_seen_s;   /* first and last frame with a body */
+    int64_t t_start_us, t_seen_us; /* first and last frame with a body */
     bool gap_since_ref;      /* a gap happened since the reference size was fixed */
     float ref_acc[GS_SESSION_REF_N];
     uint32_t ref_n;
-    double ref_px;           /* the session's standing size, NaN until ref_n reaches GS_SESSION_REF_N */
+    gs_real ref_px;          /* the session's standing size, NaN until ref_n reaches GS_SESSION_REF_N */
     uint32_t odd_run;        /* consecutive standing frames off the reference after a gap */
     uint32_t n_jumps, n_rejected;
-    double best_jump_m, sum_jump_m, best_flight_s, sum_flight_s, sum_v_m_s;
+    gs_real best_jump_m, sum_jump_m, best_flight_s, sum_flight_s, sum_v_m_s;
     uint32_t n_jump_h, n_v, n_flight_t;  /* jumps with a known jump height / take-off velocity / flight time */
 } gs_session;
 
@@ -32,11 +32,11 @@ typedef struct {
 #define GS_SESSION_ENDED   0x1u
 #define GS_SESSION_STARTED 0x2u
 
-void gs_session_init(gs_session *s, double absence_s, double new_body_rel);
+void gs_session_init(gs_session *s, int64_t absence_us, gs_real new_body_rel);
 /* One frame: present = a body was detected; stand_px = its standing size when
  * this frame was a still, upright one (NaN otherwise). Returns GS_SESSION_*
  * bits; on ENDED, *end_reason names why ("absence", "new_body"). */
-uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_px, const char **end_reason);
+uint32_t gs_session_frame(gs_session *s, int64_t t_us, bool present, gs_real stand_px, const char **end_reason);
 /* A flight of this session (accepted or rejected). */
 void gs_session_jump(gs_session *s, const gs_ev_jump *j);
 /* Fill a GS_EV_SESSION event for the open session; stature from the caller's aggregate. */

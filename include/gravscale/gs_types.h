@@ -11,10 +11,9 @@
 
 #define GS_VERSION "0.1.0"
 
-/* The arithmetic of the fits: double on hosts, float on single-precision FPUs
- * (the cortex-m4 build sets -DGS_REAL=float; docs/firmware.md has the numbers).
- * Absolute times stay double everywhere: only centred, scaled differences of
- * them enter gs_real arithmetic. */
+/* The arithmetic of the fits and every measured value: double on hosts, float on
+ * single-precision FPUs (the cortex-m4 build sets -DGS_REAL=float; docs/firmware.md
+ * has the numbers). Times are not gs_real: they are integer microseconds (gs_time.h). */
 #ifndef GS_REAL
 #define GS_REAL double
 #endif
@@ -58,7 +57,7 @@ typedef enum {
  * pixel size this frame (stature in px when upright, ball diameter); NaN where
  * unknown. */
 typedef struct {
-    double t_s;      /* source timestamp, seconds */
+    int64_t t_us;    /* source timestamp, microseconds (gs_time.h) */
     float x_px;      /* COM x */
     float y_px;      /* COM y (down) */
     float w;         /* weight 0..1 (0 = unusable frame) */

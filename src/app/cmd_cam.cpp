@@ -628,6 +628,8 @@ int run(const Options &o)
                 st.dropped_seq = cap->drops().by_sequence();
                 st.dropped_time = cap->drops().by_time();
                 det->process(frame.bgr, frame.t_s, obs);
+                // the driver's integer microseconds as they are; other sources' seconds rounded
+                const int64_t t_us = frame.t_us != GS_T_NONE ? frame.t_us : gs_time_us_of_s(frame.t_s);
                 for (const gs::DetectorObs &b : obs) {
                     gs_pipeline *p = pipes.get(static_cast<uint32_t>(b.track));
                     if (!p) {
@@ -635,11 +637,11 @@ int run(const Options &o)
                         continue;
                     }
                     gs_status ps = layout == GS_LAYOUT_POINT
-                                       ? gs_pipeline_push_point(p, frame.t_s, static_cast<float>(b.x_px),
-                                                                static_cast<float>(b.y_px),
-                                                                static_cast<float>(b.confidence),
-                                                                static_cast<float>(b.size_px))
-                                       : gs_pipeline_push_keypoints(p, frame.t_s, b.kp.data());
+                                       ? gs_pipeline_push_point_us(p, t_us, static_cast<float>(b.x_px),
+                                                                   static_cast<float>(b.y_px),
+                                                                   static_cast<float>(b.confidence),
+                                                                   static_cast<float>(b.size_px))
+                                       : gs_pipeline_push_keypoints_us(p, t_us, b.kp.data());
                     if (ps != GS_OK) pipes.refused++;
                 }
             }

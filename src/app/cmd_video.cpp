@@ -234,9 +234,9 @@ void record_event(App &a, const gs_event *ev)
         gs::JumpRecord r;
         r.track = j.track;
         r.index = j.index;
-        r.t_takeoff_s = j.t_takeoff_s;
-        r.t_land_s = j.t_land_s;
-        r.t_apex_s = j.t_apex_s;
+        r.t_takeoff_s = gs_time_s_of_us(j.t_takeoff_us);  // NaN for GS_T_NONE
+        r.t_land_s = gs_time_s_of_us(j.t_land_us);
+        r.t_apex_s = gs_time_s_of_us(j.t_apex_us);
         r.a_px_s2 = j.a_px_s2;
         r.g_dir_deg = j.g_dir_deg;
         r.q_m_per_px = j.q_m_per_px;
@@ -266,6 +266,30 @@ void record_event(App &a, const gs_event *ev)
     }
 }
 
+// The feet's take-off and landing (seconds) into the jump, rounded to the microsecond;
+// the flight time is the feet's own span (unrounded: the height follows it as before).
+// false (j untouched) when a time is not representable.
+bool feet_times_us(double t0_s, double t1_s, gs_ev_jump *j)
+{
+    const int64_t t0_us = gs_time_us_of_s(t0_s), t1_us = gs_time_us_of_s(t1_s);
+    if (t0_us == GS_T_NONE || t1_us == GS_T_NONE) return false;
+    j->t_takeoff_us = t0_us;
+    j->t_land_us = t1_us;
+    j->flight_time_s = t1_s - t0_s;
+    return true;
+}
+
+// A flight of the visit e: not over more than 1 s before it started nor begun more than
+// 1 s after it ended; an unknown time on either side does not exclude it.
+bool within_session(const gs_ev_jump &j, const gs_ev_session &e)
+{
+    const bool known_start = j.t_land_us != GS_T_NONE && e.t_start_us != GS_T_NONE;
+    const bool known_end = j.t_takeoff_us != GS_T_NONE && e.t_end_us != GS_T_NONE;
+    if (known_start && j.t_land_us < e.t_start_us - GS_US_PER_S) return false;
+    if (known_end && j.t_takeoff_us > e.t_end_us + GS_US_PER_S) return false;
+    return true;
+}
+
 void on_event(void *ctx, const gs_event *ev)
 {
     App &a = *static_cast<App *>(ctx);
@@ -274,15 +298,14 @@ void on_event(void *ctx, const gs_event *ev)
     if (ev->type == GS_EV_JUMP && a.watch) {  // what the frames say about this flight
         marked = *ev;
         gs_ev_jump &j = marked.u.jump;
-        j.warnings |= a.watch->flight_warnings(j.t_takeoff_s, j.t_land_s, j.t_apex_s);
+        // the scene watch counts in the frames' seconds; unknown times are NaN there
+        const double tk_s = gs_time_s_of_us(j.t_takeoff_us), tl_s = gs_time_s_of_us(j.t_land_us);
+        j.warnings |= a.watch->flight_warnings(tk_s, tl_s, gs_time_s_of_us(j.t_apex_us));
         // a jumper's flight is the feet's: off the ground to back on it; its height by the
         // jump-test convention h = g T^2 / 8 (the COM's rise differs by the body's shape change)
         double t0, t1, g = j.q_m_per_px * j.a_px_s2;
-        if (a.watch->feet_flight(j.t_takeoff_s, j.t_land_s, j.a_px_s2, &t0, &t1) &&
-            std::fabs(t0 - j.t_takeoff_s) < 0.15 && std::fabs(t1 - j.t_land_s) < 0.15) {
-            j.t_takeoff_s = t0;
-            j.t_land_s = t1;
-            j.flight_time_s = t1 - t0;
+        if (a.watch->feet_flight(tk_s, tl_s, j.a_px_s2, &t0, &t1) && std::fabs(t0 - tk_s) < 0.15 &&
+            std::fabs(t1 - tl_s) < 0.15 && feet_times_us(t0, t1, &j)) {
             if (std::isfinite(g)) {
                 j.jump_height_m = g * j.flight_time_s * j.flight_time_s / 8.0;
                 j.takeoff_velocity_m_s = 0.5 * g * j.flight_time_s;
@@ -297,7 +320,7 @@ void on_event(void *ctx, const gs_event *ev)
         double best_h = NAN, sum_h = 0, best_t = NAN, sum_t = 0, sum_v = 0;
         int n = 0;
         for (const gs_ev_jump &j : a.person_jumps) {
-            if (j.t_land_s < e.t_start_s - 1.0 || j.t_takeoff_s > e.t_end_s + 1.0) continue;
+            if (!within_session(j, e)) continue;
             if (!std::isfinite(j.jump_height_m) || !std::isfinite(j.flight_time_s)) continue;
             if (!(j.jump_height_m <= best_h)) best_h = j.jump_height_m;
             if (!(j.flight_time_s <= best_t)) best_t = j.flight_time_s;
@@ -342,7 +365,8 @@ void judge_jump(void *ctx, gs_ev_jump *j)
 {
     App &a = *static_cast<App *>(ctx);
     if (!a.watch || !j->accepted) return;
-    if (a.watch->other_rejects(j->t_takeoff_s, j->t_land_s, j->t_apex_s)) {
+    if (a.watch->other_rejects(gs_time_s_of_us(j->t_takeoff_us), gs_time_s_of_us(j->t_land_us),
+                               gs_time_s_of_us(j->t_apex_us))) {
         j->accepted = false;
         j->reason = GS_REJ_OTHER_MOTION;
     }
@@ -715,7 +739,7 @@ int run(const Options &o)
             if (on) {  // guidance: a condition just started
                 std::memset(&ev, 0, sizeof ev);
                 ev.type = GS_EV_WARNING;
-                ev.u.warning.t_s = f.t_s;
+                ev.u.warning.t_us = gs_time_us_of_s(f.t_s);
                 ev.u.warning.warnings = on;
                 on_event(&app, &ev);
             }

@@ -7,7 +7,6 @@
 #include <math.h>
 
 #include "gravscale/gs_agg.h"
-#include "gs_dbits.h"
 
 /* With one flight the between-flight scatter cannot be seen; a per-flight
  * relative scatter (pose, size and outlier flights the fit's SE misses) is
@@ -80,19 +79,19 @@ void gs_agg_init(gs_agg *a)
     a->n_accepted = a->n_rejected = 0;
 }
 
-void gs_agg_add(gs_agg *a, double value_m, double se_m)
+void gs_agg_add(gs_agg *a, gs_real value_m, gs_real se_m)
 {
     if (!a) {
         return;
     }
-    /* A flight without a usable size was a flight that failed: count it as rejected. */
-    if (!gs_dpositive(value_m)) {
+    /* A flight without a usable size (finite, > 0) was a flight that failed: count it as rejected. */
+    if (!(value_m > GS_R(0.0) && value_m < (gs_real)INFINITY)) {
         a->n_rejected++;
         return;
     }
     a->value[a->next] = (float)value_m;
     /* finite and >= 0 (-0 included); an unknown SE is kept as NaN */
-    bool se_ok = gs_dbits(se_m) < GS_DBITS_INF || gs_dbits(se_m) == GS_DBITS_SIGN;
+    bool se_ok = se_m >= GS_R(0.0) && se_m < (gs_real)INFINITY;
     a->se[a->next] = se_ok ? (float)se_m : NAN;
     a->next = (a->next + 1u) % GS_AGG_MAX;
     if (a->held < GS_AGG_MAX) {

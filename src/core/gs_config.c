@@ -1,6 +1,7 @@
 /* gs_config.c - "[section]" / "key = value" text parsed in place (no heap, no
  * copies), each key routed to its section's handler; the [core] handler.
- * double: parsed once at start-up. */
+ * Numbers are parsed and range-checked in double (once, at start-up) and stored as
+ * their fields' types; g in gs_real (a device that bakes its profile links no double). */
 #include "gravscale/gs_config.h"
 #include "gravscale/gs_num.h"
 
@@ -238,7 +239,7 @@ gs_status gs_cfg_parse(const char *text, size_t len, const gs_cfg_section *secti
 
 /* ------------------------------------------------------------------ [core] */
 
-typedef enum { T_DBL, T_DBL_AUTO, T_FLT, T_U32, T_U32_POW2 } num_type;
+typedef enum { T_REAL, T_REAL_AUTO, T_FLT, T_U32, T_U32_POW2 } num_type;
 
 /* A numeric key: its range in thousandths (milli / 1000.0, one correctly rounded
  * division, is the double nearest the decimal bound, as the literal would be:
@@ -256,9 +257,9 @@ _Static_assert(sizeof(gs_core_config) <= 256, "num_key.off is 8 bits");
 
 /* every numeric [core] key with its range (docs/config.md lists the same) */
 static const num_key k_num_keys[] = {
-    NK(g_m_s2, T_DBL_AUTO, 9.7, 9.9),
-    NK(latitude_deg, T_DBL_AUTO, -90, 90),
-    NK(altitude_m, T_DBL, -500, 9000),
+    NK(g_m_s2, T_REAL_AUTO, 9.7, 9.9),
+    NK(latitude_deg, T_REAL_AUTO, -90, 90),
+    NK(altitude_m, T_REAL, -500, 9000),
     NK(min_conf, T_FLT, 0, 1),
     NK(ring_capacity, T_U32_POW2, 64, 65536),
     NK(min_flight_s, T_FLT, 0.05, 2),
@@ -279,7 +280,7 @@ void gs_core_config_default(gs_core_config *c)
     static const gs_core_config k_default = {
         .g_m_s2 = NAN,
         .latitude_deg = NAN,
-        .altitude_m = 0.0,
+        .altitude_m = GS_R(0.0),
         .mass_table = GS_MASS_DELEVA,
         .stature = GS_STATURE_ANTHRO,
         .min_conf = 0.1f, /* blurred fast limbs come with low confidence but usable positions */
@@ -359,11 +360,11 @@ static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, siz
         return GS_OK;
     }
     double x;
-    if (k->type == T_DBL_AUTO && is_lit(v, n, "auto")) {
+    if (k->type == T_REAL_AUTO && is_lit(v, n, "auto")) {
         x = NAN; /* explicit "unset" */
     } else {
         if (!gs_num_parse(v, n, &x)) {
-            copy_cstr(msg, cap, k->type == T_DBL_AUTO ? "not a number (or auto)" : "not a number");
+            copy_cstr(msg, cap, k->type == T_REAL_AUTO ? "not a number (or auto)" : "not a number");
             return GS_EINVAL;
         }
         if (!dbl_ok(k, x, false)) {
@@ -375,7 +376,8 @@ static gs_status set_num(gs_core_config *c, const num_key *k, const char *v, siz
         float f = (float)x;
         memcpy(field, &f, sizeof f);
     } else {
-        memcpy(field, &x, sizeof x);
+        gs_real r = (gs_real)x;
+        memcpy(field, &r, sizeof r);
     }
     return GS_OK;
 }
@@ -467,14 +469,17 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
             ok = int_ok(k, u);
         } else {
             double x;
+            bool as_float = k->type == T_FLT || GS_REAL_IS_FLOAT;  /* the field holds a float */
             if (k->type == T_FLT) {
                 float f;
                 memcpy(&f, field, sizeof f);
                 x = (double)f;
             } else {
-                memcpy(&x, field, sizeof x);
+                gs_real r;
+                memcpy(&r, field, sizeof r);
+                x = (double)r;
             }
-            ok = (k->type == T_DBL_AUTO && gs_disnan(x)) || dbl_ok(k, x, k->type == T_FLT);
+            ok = (k->type == T_REAL_AUTO && gs_disnan(x)) || dbl_ok(k, x, as_float);
         }
         if (!ok) {
             char msg[64];
@@ -495,22 +500,23 @@ gs_status gs_core_config_check(const gs_core_config *c, gs_cfg_error *err)
     return GS_OK;
 }
 
-double gs_gravity_m_s2(double latitude_deg, double altitude_m)
+gs_real gs_gravity_m_s2(gs_real latitude_deg, gs_real altitude_m)
 {
     /* WGS-84 normal gravity on the ellipsoid (Somigliana), then the free-air gradient */
-    const double pi = 3.14159265358979323846;
-    /* float where double is emulated: g to 1e-7 is 100x finer than any site needs */
-    double s = GS_SIN(latitude_deg * (pi / 180.0));
-    double s2 = s * s;
-    double g0 = 9.7803253359 * (1.0 + 0.00193185265241 * s2) / GS_SQRT(1.0 - 0.00669437999013 * s2);
-    return g0 - 3.086e-6 * altitude_m;
+    const gs_real deg = GS_R(3.14159265358979323846 / 180.0);
+    /* float where gs_real is float: g to 1e-6 is 10x finer than any site needs */
+    gs_real s = GS_REAL_IS_FLOAT ? (gs_real)gs_sinf((float)(latitude_deg * deg)) : (gs_real)sin((double)(latitude_deg * deg));
+    gs_real s2 = s * s;
+    gs_real g0 = GS_R(9.7803253359) * (GS_R(1.0) + GS_R(0.00193185265241) * s2) /
+                 GS_SQRT(GS_R(1.0) - GS_R(0.00669437999013) * s2);
+    return g0 - GS_R(3.086e-6) * altitude_m;
 }
 
-double gs_core_config_g(const gs_core_config *c)
+gs_real gs_core_config_g(const gs_core_config *c)
 {
-    if (!c) return 9.81;
-    if (gs_dfinite(c->g_m_s2)) return c->g_m_s2;
-    if (gs_dfinite(c->latitude_deg))
-        return gs_gravity_m_s2(c->latitude_deg, gs_dfinite(c->altitude_m) ? c->altitude_m : 0.0);
-    return 9.81;
+    if (!c) return GS_R(9.81);
+    if (isfinite(c->g_m_s2)) return c->g_m_s2;
+    if (isfinite(c->latitude_deg))
+        return gs_gravity_m_s2(c->latitude_deg, isfinite(c->altitude_m) ? c->altitude_m : GS_R(0.0));
+    return GS_R(9.81);
 }

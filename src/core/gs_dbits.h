@@ -30,10 +30,33 @@ static inline bool gs_dfinite(double x)
 
 static inline bool gs_disnan(double x) { return gs_dbits_abs(x) > GS_DBITS_INF; }
 
-/* finite and > 0 (not +-0, not NaN) */
-static inline bool gs_dpositive(double x) { return gs_dbits(x) - 1u < GS_DBITS_INF - 1u; }
+/* (double)x from the IEEE bits, exactly (subnormals normalized, inf, NaN with its
+ * payload): where double is emulated the conversion is otherwise a libgcc call */
+static inline double gs_dwiden(float x)
+{
+    uint32_t b;
+    memcpy(&b, &x, sizeof b);
+    uint64_t d = (uint64_t)(b >> 31) << 63;
+    uint32_t ex = (b >> 23) & 0xFFu, m = b & 0x7FFFFFu;
+    if (ex == 0xFFu) {
+        d |= GS_DBITS_INF | (uint64_t)m << 29; /* the quiet bit lands on double's */
+    } else if (ex != 0u) {
+        d |= (uint64_t)(ex + (1023u - 127u)) << 52 | (uint64_t)m << 29;
+    } else if (m != 0u) {
+        /* m * 2^-149: shift the leading bit up to the hidden bit's place */
+        uint32_t e = 1023u - 126u;
+        while (!(m & 0x800000u)) {
+            m <<= 1;
+            e--;
+        }
+        d |= (uint64_t)e << 52 | (uint64_t)(m & 0x7FFFFFu) << 29;
+    }
+    double r;
+    memcpy(&r, &d, sizeof r);
+    return r;
+}
 
-/* ---- in gs_dbits.c: one copy each of what libgcc's double routines did ---- */
+/* ---- in gs_dbits.c: one copy of what libgcc's double compare did ---- */
 
 /* Where doubles are passed in FPU registers (hard-float ARM) but computed in core
  * registers (soft double on a single-precision FPU), these take them in core registers
@@ -43,9 +66,6 @@ static inline bool gs_dpositive(double x) { return gs_dbits(x) - 1u < GS_DBITS_I
 #else
 #define GS_DBITS_PCS
 #endif
-
-/* trunc(|x|) for |x| < 2^64 (finite), exact, without libgcc's double-to-integer routines */
-GS_DBITS_PCS uint64_t gs_dtrunc_abs(double x);
 
 /* IEEE's order of a and b from the bits: -1 (a < b), 0 (equal; -0 == +0), 1 (a > b), or
  * 2 (unordered: a NaN). Where double is emulated each compare is otherwise a libgcc call,
@@ -60,9 +80,7 @@ GS_DBITS_PCS int gs_dcmp(double a, double b);
 #else
 #define GS_DBITS_SOFT 0
 #endif
-static inline bool gs_dlt(double a, double b) { return GS_DBITS_SOFT ? gs_dcmp(a, b) < 0 : a < b; }
 static inline bool gs_dle(double a, double b) { return GS_DBITS_SOFT ? gs_dcmp(a, b) <= 0 : a <= b; }
-static inline bool gs_dgt(double a, double b) { return GS_DBITS_SOFT ? gs_dcmp(a, b) == 1 : a > b; }
 static inline bool gs_dge(double a, double b) { return GS_DBITS_SOFT ? (unsigned)gs_dcmp(a, b) <= 1u : a >= b; }
 
 #endif

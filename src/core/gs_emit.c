@@ -1,6 +1,7 @@
 /* gs_emit.c - events as JSON Lines or NMEA 0183-style sentences in a caller
  * buffer; all or nothing, never past cap. Field layout: docs/protocol.md.
- * double: event fields are double (times of day-long streams); one line per event. */
+ * Times are integer microseconds, printed as seconds from their digits; values are
+ * gs_real, printed from their exact double value (a float widened from its bits). */
 #include "gravscale/gs_emit.h"
 #include "gravscale/gs_num.h"
 
@@ -104,20 +105,45 @@ static void w_fixed(gs_w *w, double v, int decimals, size_t width)
     if (!width) w_lit(w, "null");
 }
 
+/* t_us as seconds with `decimals` decimals, otherwise as w_fixed (GS_T_NONE: unknown) */
+static void w_time(gs_w *w, int64_t t_us, int decimals, size_t width)
+{
+    char t[40];
+    for (int d = decimals; d >= 0; d--) {
+        size_t n = gs_num_fmt_us(t, sizeof t, t_us, d);
+        if (n && (!width || n <= width)) {
+            w_raw(w, t, n);
+            return;
+        }
+        if (!width) break;
+    }
+    if (!width) w_lit(w, "null");
+}
+
+/* the gs_real at p as a double: exact (where gs_real is float, from its bits: no libgcc conversion) */
+static double real_at(const void *p)
+{
+    gs_real r;
+    memcpy(&r, p, sizeof r);
+    if (GS_REAL_IS_FLOAT) return gs_dwiden((float)r);
+    return (double)r;
+}
+
 /* ------------------------------------------------ fields from a table */
 
 /* What a field's bytes at its offset are and how they are written. The first
  * kinds serve both formats; then JSON's, then NMEA's. */
 enum {
     V_U32,      /* uint32_t; b = NMEA width */
-    V_FIXED,    /* double, a decimals; b = NMEA width */
-    V_SIG,      /* JSON: double, a significant digits */
+    V_FIXED,    /* gs_real, a decimals; b = NMEA width */
+    V_TIME,     /* int64_t microseconds as seconds, a decimals; b = NMEA width */
+    V_SIG,      /* JSON: gs_real, a significant digits */
     V_FLOAT,    /* JSON: float, a decimals */
     V_STR,      /* JSON: const char * string or null; a = 1: NULL is this build's version */
     V_BOOL,     /* JSON: bool as the pair k_json_bool[a] (true, false) */
     V_REASON,   /* JSON: a jump's reject reason, null when accepted */
     V_WARNINGS, /* JSON: uint32_t GS_WARN_* bits as an array of names */
-    V_CI95,     /* JSON: the doubles mid, lo, hi from here as [lo,hi] or null */
+    V_CI95,     /* JSON: the gs_reals mid, lo, hi from here as [lo,hi] or null */
     V_FLAG,     /* NMEA: bool as the character a (true) or b (false) */
     V_DIGIT,    /* NMEA: a gs_reject_reason as one digit */
     V_INITIAL,  /* NMEA: a string's first letter in upper case */
@@ -143,9 +169,11 @@ static bool w_common(gs_w *w, const void *base, const field *f)
         memcpy(&v, p, sizeof v);
         w_u32(w, v, f->b);
     } else if (f->kind == V_FIXED) {
-        double v;
-        memcpy(&v, p, sizeof v);
-        w_fixed(w, v, f->a, f->b);
+        w_fixed(w, real_at(p), f->a, f->b);
+    } else if (f->kind == V_TIME) {
+        int64_t t;
+        memcpy(&t, p, sizeof t);
+        w_time(w, t, f->a, f->b);
     } else {
         return false;
     }
@@ -222,7 +250,7 @@ static const field k_nmea_fields[] = {
     NF(gs_ev_start, version, V_TEXT, 20, 0),
     NF(gs_ev_start, fps_source, V_FIXED, 3, 10),
 #define N_JUMP 2
-    NF(gs_ev_jump, t_takeoff_s, V_FIXED, 3, 10),
+    NF(gs_ev_jump, t_takeoff_us, V_TIME, 3, 10),
     NF(gs_ev_jump, flight_time_s, V_FIXED, 3, 5),
     NF(gs_ev_jump, a_px_s2, V_FIXED, 1, 8),
     NF(gs_ev_jump, q_m_per_px, V_FIXED, 7, 9),
@@ -243,15 +271,15 @@ static const field k_nmea_fields[] = {
     NF(gs_ev_session, session, V_U32, 0, 5),
     NF(gs_ev_session, ended, V_FLAG, 'E', 'S'),
     NF(gs_ev_session, reason, V_INITIAL, 0, 0),
-    NF(gs_ev_session, t_start_s, V_FIXED, 3, 10),
-    NF(gs_ev_session, t_end_s, V_FIXED, 3, 10),
+    NF(gs_ev_session, t_start_us, V_TIME, 3, 10),
+    NF(gs_ev_session, t_end_us, V_TIME, 3, 10),
     NF(gs_ev_session, stature_m, V_FIXED, 3, 6),
     NF(gs_ev_session, n_jumps, V_U32, 0, 3),
     NF(gs_ev_session, best_jump_m, V_FIXED, 3, 5),
     NF(gs_ev_session, mean_jump_m, V_FIXED, 3, 5),
     NF(gs_ev_session, mean_flight_s, V_FIXED, 3, 5),
 #define N_WARNING 27
-    NF(gs_ev_warning, t_s, V_FIXED, 3, 10),
+    NF(gs_ev_warning, t_us, V_TIME, 3, 10),
     NF(gs_ev_warning, warnings, V_HEX8, 0, 0),
 #define N_END 29
 };
@@ -343,10 +371,10 @@ static void w_warnings(gs_w *w, uint32_t bits)
 }
 
 /* [lo,hi], or null: an interval with an unknown end is no interval */
-static void w_ci95(gs_w *w, const double *mid_lo_hi)
+static void w_ci95(gs_w *w, const void *mid_lo_hi)
 {
     double v[3];
-    memcpy(v, mid_lo_hi, sizeof v);
+    for (int i = 0; i < 3; i++) v[i] = real_at((const gs_real *)mid_lo_hi + i);
     if (gs_dfinite(v[1]) && gs_dfinite(v[2]) && gs_dfinite(v[0])) {
         w_raw(w, "[", 1);
         w_fixed(w, v[1], 4, 0);
@@ -370,7 +398,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
     bool b;
     switch (f->kind) {
     case V_SIG:
-        memcpy(&d, p, sizeof d);
+        d = real_at(p);
         char t[40];
         size_t n = gs_num_fmt_sig(t, sizeof t, d, f->a);
         if (n) w_raw(w, t, n);
@@ -378,7 +406,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         break;
     case V_FLOAT:
         memcpy(&x, p, sizeof x);
-        w_fixed(w, (double)x, f->a, 0);
+        w_fixed(w, gs_dwiden(x), f->a, 0);
         break;
     case V_STR:
         memcpy(&s, p, sizeof s);
@@ -399,7 +427,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         w_warnings(w, bits);
         break;
     }
-    default: w_ci95(w, (const double *)p); break;
+    default: w_ci95(w, p); break;
     }
 }
 
@@ -412,10 +440,10 @@ typedef struct {
 #define JF(type, name, kind, a) {#name, {(uint8_t)offsetof(type, name), kind, a, 0}}
 #define JFX(type, name, at, kind, a) {name, {(uint8_t)offsetof(type, at), kind, a, 0}}
 
-_Static_assert(offsetof(gs_ev_height, ci95_lo_m) == offsetof(gs_ev_height, height_m) + sizeof(double) &&
-                   offsetof(gs_ev_height, ci95_hi_m) == offsetof(gs_ev_height, height_m) + 2 * sizeof(double) &&
-                   offsetof(gs_ev_session, ci95_lo_m) == offsetof(gs_ev_session, stature_m) + sizeof(double) &&
-                   offsetof(gs_ev_session, ci95_hi_m) == offsetof(gs_ev_session, stature_m) + 2 * sizeof(double),
+_Static_assert(offsetof(gs_ev_height, ci95_lo_m) == offsetof(gs_ev_height, height_m) + sizeof(gs_real) &&
+                   offsetof(gs_ev_height, ci95_hi_m) == offsetof(gs_ev_height, height_m) + 2 * sizeof(gs_real) &&
+                   offsetof(gs_ev_session, ci95_lo_m) == offsetof(gs_ev_session, stature_m) + sizeof(gs_real) &&
+                   offsetof(gs_ev_session, ci95_hi_m) == offsetof(gs_ev_session, stature_m) + 2 * sizeof(gs_real),
                "V_CI95 reads mid, lo, hi in a row");
 
 /* every line's fields, event by event (docs/protocol.md) */
@@ -429,10 +457,10 @@ static const json_field k_json_fields[] = {
 #define J_JUMP 5
     JF(gs_ev_jump, track, V_U32, 0),
     JF(gs_ev_jump, index, V_U32, 0),
-    JF(gs_ev_jump, t_takeoff_s, V_FIXED, 4),
-    JF(gs_ev_jump, t_land_s, V_FIXED, 4),
+    JFX(gs_ev_jump, "t_takeoff_s", t_takeoff_us, V_TIME, 4),
+    JFX(gs_ev_jump, "t_land_s", t_land_us, V_TIME, 4),
     JF(gs_ev_jump, flight_time_s, V_FIXED, 4),
-    JF(gs_ev_jump, t_apex_s, V_FIXED, 4),
+    JFX(gs_ev_jump, "t_apex_s", t_apex_us, V_TIME, 4),
     JF(gs_ev_jump, a_px_s2, V_SIG, 6),
     JF(gs_ev_jump, a_px_se_s2, V_SIG, 6),
     JF(gs_ev_jump, g_dir_deg, V_FIXED, 2),
@@ -459,8 +487,8 @@ static const json_field k_json_fields[] = {
     JF(gs_ev_session, session, V_U32, 0),
     JFX(gs_ev_session, "state", ended, V_BOOL, 1),
     JF(gs_ev_session, reason, V_STR, 0),
-    JF(gs_ev_session, t_start_s, V_FIXED, 4),
-    JF(gs_ev_session, t_end_s, V_FIXED, 4),
+    JFX(gs_ev_session, "t_start_s", t_start_us, V_TIME, 4),
+    JFX(gs_ev_session, "t_end_s", t_end_us, V_TIME, 4),
     JF(gs_ev_session, stature_m, V_FIXED, 4),
     JFX(gs_ev_session, "ci95_m", stature_m, V_CI95, 0),
     JF(gs_ev_session, n_jumps, V_U32, 0),
@@ -472,16 +500,16 @@ static const json_field k_json_fields[] = {
     JF(gs_ev_session, mean_takeoff_velocity_m_s, V_FIXED, 3),
 #define J_WARNING 46
     JF(gs_ev_warning, track, V_U32, 0),
-    JF(gs_ev_warning, t_s, V_FIXED, 4),
+    JFX(gs_ev_warning, "t_s", t_us, V_TIME, 4),
     JF(gs_ev_warning, warnings, V_WARNINGS, 0),
 #define J_TRACE 49
 #if GS_WITH_TRACE /* trace events (gs_features.h): without them, no form (returns 0) */
 #define J_STATE J_TRACE
-    JF(gs_ev_state, t_s, V_FIXED, 4),
+    JFX(gs_ev_state, "t_s", t_us, V_TIME, 4),
     JF(gs_ev_state, from, V_STR, 0),
     JF(gs_ev_state, to, V_STR, 0),
 #define J_SAMPLE 52
-    JF(gs_ev_sample, t_s, V_FIXED, 4),
+    JFX(gs_ev_sample, "t_s", t_us, V_TIME, 4),
     JF(gs_ev_sample, x_px, V_FLOAT, 2),
     JF(gs_ev_sample, y_px, V_FLOAT, 2),
     JF(gs_ev_sample, w, V_FLOAT, 3),
@@ -489,8 +517,8 @@ static const json_field k_json_fields[] = {
     JF(gs_ev_sample, upright, V_FLOAT, 3),
 #define J_FIT 58
     JF(gs_ev_fit, purpose, V_STR, 0),
-    JF(gs_ev_fit, t_first_s, V_FIXED, 4),
-    JF(gs_ev_fit, t_last_s, V_FIXED, 4),
+    JFX(gs_ev_fit, "t_first_s", t_first_us, V_TIME, 4),
+    JFX(gs_ev_fit, "t_last_s", t_last_us, V_TIME, 4),
     JF(gs_ev_fit, n, V_U32, 0),
     JF(gs_ev_fit, a_px_s2, V_SIG, 6),
     JF(gs_ev_fit, g_dir_deg, V_FIXED, 2),

@@ -6,7 +6,6 @@
 #include <string.h>
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
-#include "gs_dbits.h"
 
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
@@ -28,22 +27,21 @@
 
 static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
-/* An empty fit at a valid centre and scale: all sums and R zero (all-zero bits are +0.0). */
-static void fit_start(gs_fit *f, double t0_s, double tscale_s)
+/* An empty fit at a valid centre and scale (> 0 us): all sums and R zero (all-zero bits are +0.0). */
+static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
 {
     memset(f, 0, sizeof *f);
-    f->t0_s = t0_s;
-    f->tscale_s = tscale_s;
+    f->t0_us = t0_us;
+    f->tscale_s = gs_time_span_s(tscale_us, 0);
 }
 
-void gs_fit_init(gs_fit *f, double t0_s, double tscale_s)
+void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
 {
     if (!f) {
         return;
     }
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    fit_start(f, gs_dfinite(t0_s) ? t0_s : 0.0,
-              gs_dpositive(tscale_s) ? tscale_s : 1.0);
+    fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, tscale_us > 0 ? tscale_us : GS_US_PER_S);
 }
 
 /* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
@@ -53,10 +51,10 @@ static int rix(int i, int j)
     return base[i] + (j - i);
 }
 
-/* The centred, scaled time of an absolute time t_s (the fit's one double step). */
-static gs_real fit_tau(double t_s, double t0_s, double tscale_s)
+/* The centred, scaled time of t_us: the exact integer span over the scale, both in microseconds. */
+static gs_real fit_tau(int64_t t_us, int64_t t0_us, gs_real tscale_us)
 {
-    return (gs_real)((t_s - t0_s) / tscale_s);
+    return gs_time_span_us(t_us, t0_us) / tscale_us;
 }
 
 /* Entry j of row k of the augmented factor [R | zx zy]: columns 0-2 are R's, 3 and 4 the right-hand sides. */
@@ -100,17 +98,17 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
     f->n++;
 }
 
-void gs_fit_add(gs_fit *f, double t_s, gs_real x_px, gs_real y_px, gs_real w)
+void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
 {
-    if (!f || !(w > 0.0) || !isfinite(w) || !gs_dfinite(t_s) || !isfinite(x_px) || !isfinite(y_px)) {
+    if (!f || !(w > GS_R(0.0)) || !isfinite(w) || !gs_time_ok(t_us) || !isfinite(x_px) || !isfinite(y_px)) {
         return;
     }
-    add_row(f, fit_tau(t_s, f->t0_s, f->tscale_s), x_px, y_px, w);
+    add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
 }
 
 static void nan_result(gs_fit_result *out)
 {
-    const double nan = (double)NAN;
+    const gs_real nan = (gs_real)NAN;
     out->x0_px = out->vx_px_s = out->ax_px_s2 = nan;
     out->y0_px = out->vy_px_s = out->ay_px_s2 = nan;
     out->a_px_s2 = out->a_se_px_s2 = out->g_dir_deg = out->rms_px = nan;
@@ -138,7 +136,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
     if (!f || !out) {
         return GS_EINVAL;
     }
-    out->t0_s = f->t0_s;
+    out->t0_us = f->t0_us;
     out->n = f->n;
     nan_result(out);
     if (f->n < 3) {
@@ -156,10 +154,10 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
     }
     back_sub(f->r, f->zx, cx);
     back_sub(f->r, f->zy, cy);
-    ts = (gs_real)f->tscale_s;
+    ts = f->tscale_s;
     ts2 = ts * ts;
     {
-        /* the results are gs_real too (gs_fit_result); only t0_s is double */
+        /* the results are gs_real too (gs_fit_result) */
         gs_real ax = GS_R(2.0) * cx[2] / ts2, ay = GS_R(2.0) * cy[2] / ts2;
         out->x0_px = (gs_real)cx[0];
         out->vx_px_s = (gs_real)(cx[1] / ts);
@@ -231,7 +229,8 @@ typedef struct {
     uint64_t first;
     uint32_t count;
     uint32_t m; /* usable samples in the window */
-    double t0_s, tscale_s;  /* double: absolute time (a stream may run for days) */
+    int64_t t0_us, tscale_us; /* the window's centre and length (> 0, below the ring's 2^31 us span) */
+    gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
 } gs_win;
 
 static uint32_t xorshift32(uint32_t *state)
@@ -271,8 +270,8 @@ static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
     if (!s || !sample_usable(s)) {
         return false;
     }
-    /* absolute times meet in double; the centred, unit-length tau fits a float */
-    out->tau = fit_tau(gs_ring_sample_t_s(wn->ring, s), wn->t0_s, wn->tscale_s);
+    /* the span from the centre is exact; the centred, unit-length tau fits a float */
+    out->tau = fit_tau(gs_ring_sample_t_us(wn->ring, s), wn->t0_us, wn->tscale_us_r);
     out->xy_px[0] = s->x_px;
     out->xy_px[1] = s->y_px;
     out->w = gs_sample_w(s);
@@ -408,7 +407,7 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
 {
     gs_fit f;
     uint32_t i;
-    fit_start(&f, wn->t0_s, wn->tscale_s);  /* both finite, the scale positive */
+    fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
     for (i = 0; i < wn->count; i++) {
         gs_fsamp s;
         float w = win_usable(wn, i, &s) ? sample_weight(&s, model, mode, cut) : 0.0f;
@@ -630,7 +629,7 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
  * or fewer than 3 usable ones at distinct times remain. */
 static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint32_t count)
 {
-    double t_min = 0.0, t_max = 0.0;  /* absolute times */
+    int64_t t_min = 0, t_max = 0;  /* absolute times */
     uint32_t i, m = 0;
     for (i = 0; i < count; i++) {
         const gs_sample *s = gs_ring_at(ring, first + i);
@@ -640,14 +639,14 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
         }
         if (sample_usable(s)) {
             /* the ring's times never decrease: the first usable is the earliest, the last the latest */
-            t_max = gs_ring_sample_t_s(ring, s);
+            t_max = gs_ring_sample_t_us(ring, s);
             if (m == 0) {
                 t_min = t_max;
             }
             m++;
         }
     }
-    if (m < 3 || !gs_dgt(t_max, t_min)) {
+    if (m < 3 || !(t_max > t_min)) {
         return GS_EINVAL;
     }
     wn->ring = ring;
@@ -655,8 +654,9 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     wn->count = count;
     wn->m = m;
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
-    wn->t0_s = t_min + 0.5 * (t_max - t_min);
-    wn->tscale_s = t_max - t_min;
+    wn->tscale_us = t_max - t_min;  /* held samples are less than 2^31 us apart */
+    wn->t0_us = t_min + (wn->tscale_us >> 1);  /* a shift: no 64-bit division */
+    wn->tscale_us_r = gs_time_span_us(wn->tscale_us, 0);
     return GS_OK;
 }
 
@@ -684,7 +684,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (!out) {
         return GS_EINVAL;
     }
-    out->t0_s = (double)NAN;
+    out->t0_us = GS_T_NONE;
     out->n = 0;
     nan_result(out);
     if (!ring || !keep || count == 0) {

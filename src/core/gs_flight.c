@@ -8,23 +8,16 @@
  * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
  * the boundary) and the final robust 2D fit uses only samples in free flight.
  *
- * float vs double (the Cortex-M4's FPU is single precision; double is emulated):
- * the per-frame state machine (u, noise, levels, CUSUM, sizes), the per-sample
- * and per-boundary-candidate work (test_sample, pred_var_factor, piecewise_ssr,
- * solve_spd, all of gs_fit.c) and closing a flight (apex, SE, q, height) are
- * gs_real: float on the M4, double on hosts (bit-identical to the all-double
- * code). What stays double, and why:
- *  - absolute times (t_s, T0, T1, last_t_s, peak_t, blk_t0, still_since, ...):
- *    a stream runs for days and float seconds lose milliseconds after hours;
- *  - time differences compared with time thresholds (gaps, latency, settling)
- *    and the frame interval (dt_med_s) with the frame counts taken from it by
- *    ceil (core width, boundary grid steps, speed lag): these are knife edges
- *    (a ratio of exactly 6 frames rounds up or not); in float they flipped
- *    differently from the host's double on a tenth of a held-out set's
- *    flights, in double they decide as on the host;
- *  - the event's public fields (double). */
+ * Numbers: every value (u, noise, levels, CUSUM, sizes, fits, boundary models,
+ * apex, SE, q, height) is gs_real: float on the M4 (single-precision FPU), double
+ * on hosts. Every time is integer microseconds (gs_time.h), and so is every
+ * decision taken from times: gaps, latency and settling against the configured
+ * spans, and the frame counts taken from the frame interval (kept in 1/16 us) by
+ * an integer ceil (core width, boundary grid steps, speed lag). Those are knife
+ * edges (a span of exactly 6 frames rounds up or not); in integers the device
+ * decides them exactly as the host does. Only spans inside a flight window become
+ * gs_real seconds (gs_time_span_s). */
 #include "gravscale/gs_flight.h"
-#include "gs_dbits.h"
 
 #include <math.h>
 #include <string.h>
@@ -41,28 +34,19 @@
 /* small helpers called from several places: one copy is smaller than inlining it everywhere */
 #define NOINLINE __attribute__((noinline))
 
-/* ceil(x) as an integer, without libm, for frame counts (finite |x| < 2^62; they are
- * far below). Truncated from the bits (gs_dbits.c); (double)t is exact and links nothing
- * new (libgcc's int-to-double conversions sit in its double add's object). */
-static NOINLINE int64_t ceil_count(double x)
-{
-    int64_t m = (int64_t)gs_dtrunc_abs(x);
-    int64_t t = (gs_dbits(x) & GS_DBITS_SIGN) ? -m : m; /* toward zero, exact */
-    return gs_dlt((double)t, x) ? t + 1 : t;
-}
 
 /* tuning: thresholds in units of the noise or of the object's size */
 #define USABLE_W_MIN     0.05f  /* lighter frames are left out of flight detection */
 #define SEED_RISE_REL    GS_R(0.03)   /* apex must rise this x size above the recent minimum */
 #define SEED_RISE_NOISE  GS_R(8.0)    /* ... and this x noise */
 #define SEED_DROP_NOISE  GS_R(2.5)    /* apex confirmed once u fell this x noise below it */
-#define CORE_HALF_S      0.07         /* half-width of the seed's core window */
+#define CORE_HALF_US     70000        /* half-width of the seed's core window */
 #define CUSUM_K          GS_R(1.3)    /* CUSUM reference: deviations below k sigma drain it */
 #define CUSUM_H          GS_R(5.0)    /* CUSUM alarm: contact */
 #define VERIFY_RMS       GS_R(2.5)    /* ... and only when the refit's residual is near the noise */
 #define VERIFY_Z         GS_R(2.0)    /* after a refit through an alarm, edge samples below this: false alarm */
 #define CUSUM_ZMAX       GS_R(6.0)    /* one sample adds at most this (a lone glitch cannot end a flight) */
-#define BOUNDARY_IN_S    0.025        /* boundary search reaches this far (at least a frame) inside the grown flight */
+#define BOUNDARY_IN_US   25000        /* boundary search reaches this far (at least a frame) inside the grown flight */
 #define GROSS_OUTLIER    GS_R(7.0)    /* perpendicular or downward deviation = bad keypoints, skipped */
 #define CONTACT_MIN_G    GS_R(0.5)    /* contact force past a boundary: at least half of g */
 #define DROP_PENALTY     GS_R(4.0)    /* SSR gain (x sigma^2) needed to drop a sample the online test kept */
@@ -75,7 +59,16 @@ static NOINLINE int64_t ceil_count(double x)
 #define LOOSE_UPRIGHT    GS_R(0.5)    /* fallback size samples (no settled stance seen yet) */
 #define MEDIAN_MAX       64     /* largest set a median is taken of */
 #define NOISE_INIT_N     9      /* second differences whose median starts the noise estimate */
-#define STAND_SETTLE_S   0.2          /* still this long before a frame counts as standing */
+#define STAND_SETTLE_US  200000       /* still this long before a frame counts as standing */
+#define SPEED_LAG_US     100000       /* stillness for the noise: speed against the sample this far back */
+/* stillness for a stance: a little further back, so that a span of exactly 0.1 s counts
+ * one frame more (4 at 30 fps, not 3): a longer lag averages more keypoint noise, which a
+ * brief stance needs (the jumpvision gym clip's only still upright frames are three at
+ * the apex); on the held-out-like set it also gave the smaller height errors */
+#define STAND_LAG_US     101000
+#define LEVEL_BLOCK_US   500000       /* the recent minimum's blocks */
+#define DT_DEFAULT_Q4    533333u      /* 1/30 s in 1/16 us: the frame interval before one is seen */
+#define DT_MAX_US        (INT64_C(1) << 26)  /* longer frame intervals count as this (67 s) */
 #define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
 
 /* isfinite of a gs_real (or float) value, in one place */
@@ -88,33 +81,32 @@ static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *
     return gs_ring_get(f->ring, i, buf) ? buf : NULL;
 }
 
-/* time of ring sample i, NaN when not held */
-static double t_at(const gs_flight *f, uint64_t i)
+/* time of ring sample i, GS_T_NONE when not held */
+static int64_t t_at(const gs_flight *f, uint64_t i)
 {
     const gs_sample *s = gs_ring_at(f->ring, i);
-    return s ? gs_ring_sample_t_s(f->ring, s) : NAN;
+    return s ? gs_ring_sample_t_us(f->ring, s) : GS_T_NONE;
 }
 
 /* Frames that weigh almost nothing (the COM lacks a whole segment, e.g. the head
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px) && gs_dfinite(s->t_s);
+    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px);
 }
 
 static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
 
-/* t1 - t0 longer than a configured span (false when either time is NaN) */
-static NOINLINE bool span_over(double t1, double t0, float span_s)
+/* t1 - t0 longer than a span (false when either time is unknown) */
+static NOINLINE bool span_over(int64_t t1_us, int64_t t0_us, int64_t span_us)
 {
-    return gs_dgt(t1 - t0, (double)span_s);
+    return t1_us != GS_T_NONE && t0_us != GS_T_NONE && t1_us - t0_us > span_us;
 }
 
-/* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side.
- * The sign of a double difference is exact, so comparing it with 0 is comparing t with T. */
-static NOINLINE double past_s(double t, double T, int side)
+/* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side. */
+static NOINLINE int64_t past_us(int64_t t_us, int64_t T_us, int side)
 {
-    double d = t - T;
+    int64_t d = t_us - T_us;
     return side < 0 ? -d : d;
 }
 
@@ -157,14 +149,14 @@ const char *gs_flight_state_name(gs_flight_state s)
     return "?";
 }
 
-static NOINLINE void set_state(gs_flight *f, gs_flight_state to, double t_s)
+static NOINLINE void set_state(gs_flight *f, gs_flight_state to, int64_t t_us)
 {
     if (f->state == to) return;
     if (GS_WITH_TRACE && f->trace) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
         ev.type = GS_EV_STATE;
-        ev.u.state.t_s = t_s;
+        ev.u.state.t_us = t_us;
         ev.u.state.from = gs_flight_state_name(f->state);
         ev.u.state.to = gs_flight_state_name(to);
         emit(f, &ev);
@@ -172,7 +164,7 @@ static NOINLINE void set_state(gs_flight *f, gs_flight_state to, double t_s)
     f->state = to;
 }
 
-static void trace_fit(const gs_flight *f, const char *purpose, double t0, double t1,
+static void trace_fit(const gs_flight *f, const char *purpose, int64_t t0_us, int64_t t1_us,
                       const gs_fit_result *r)
 {
     if (!GS_WITH_TRACE || !f->trace) return;
@@ -180,8 +172,8 @@ static void trace_fit(const gs_flight *f, const char *purpose, double t0, double
     memset(&ev, 0, sizeof ev);
     ev.type = GS_EV_FIT;
     ev.u.fit.purpose = purpose;
-    ev.u.fit.t_first_s = t0;
-    ev.u.fit.t_last_s = t1;
+    ev.u.fit.t_first_us = t0_us;
+    ev.u.fit.t_last_us = t1_us;
     ev.u.fit.n = r ? r->n : 0;
     ev.u.fit.a_px_s2 = r ? r->a_px_s2 : NAN;
     ev.u.fit.g_dir_deg = r ? r->g_dir_deg : NAN;
@@ -223,15 +215,19 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->on_event = on_event;
     f->ctx = ctx;
     f->g_m_s2 = gs_core_config_g(cfg);
+    f->min_flight_us = gs_time_us_of_cfg_s(cfg->min_flight_s);
+    f->max_flight_us = gs_time_us_of_cfg_s(cfg->max_flight_s);
+    f->max_gap_us = gs_time_us_of_cfg_s(cfg->max_gap_s);
+    f->landing_latency_us = gs_time_us_of_cfg_s(cfg->landing_latency_s);
     f->state = GS_FS_IDLE;
     f->next = gs_ring_head(ring);
     f->quiet_from = f->next;
-    f->last_t_s = NAN;
+    f->last_t_us = GS_T_NONE;
     f->up_x = GS_R(0.0);
     f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
     f->noise_px = NAN;
     restart_levels(f, UINT64_MAX);  /* no level seen yet */
-    f->dt_med_s = NAN;
+    f->dt_med_q4 = 0;               /* no frame interval seen yet */
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
@@ -258,9 +254,9 @@ static gs_real fit_sigma(const gs_flight *f, const gs_fit_result *r)
 }
 
 /* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) */
-static gs_real pred_var_factor(const gs_fit *fit, double t_s)
+static gs_real pred_var_factor(const gs_fit *fit, int64_t t_us)
 {
-    gs_real tau = (gs_real)((t_s - fit->t0_s) / fit->tscale_s);  /* absolute times meet in double */
+    gs_real tau = gs_time_span_s(t_us, fit->t0_us) / fit->tscale_s;
     gs_real x0 = GS_R(1.0), x1 = tau, x2 = tau * tau;
     const gs_real *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
     if (r[0] == GS_R(0.0) || r[3] == GS_R(0.0) || r[5] == GS_R(0.0)) return (gs_real)INFINITY;
@@ -277,8 +273,7 @@ static gs_real pred_var_factor(const gs_fit *fit, double t_s)
 static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sample_full *s, gs_real *z)
 {
     const gs_fit *fit = &f->fit;
-    /* per sample and per boundary candidate: gs_real; only the time difference is double */
-    gs_real dt = (gs_real)(s->t_s - r->t0_s);
+    gs_real dt = gs_time_span_s(s->t_us, r->t0_us);
     gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
     gs_real px = (gs_real)r->x0_px + (gs_real)r->vx_px_s * dt + GS_R(0.5) * ax * dt * dt;
     gs_real py = (gs_real)r->y0_px + (gs_real)r->vy_px_s * dt + GS_R(0.5) * ay * dt * dt;
@@ -288,7 +283,7 @@ static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sam
     gs_real up = -(ex * gx + ey * gy);
     gs_real perp = ex * (-gy) + ey * gx;
     gs_real sig = (gs_real)fit_sigma(f, r);
-    gs_real vf = pred_var_factor(fit, s->t_s);
+    gs_real vf = pred_var_factor(fit, s->t_us);
     gs_real tot = sig * GS_SQRT(GS_R(1.0) + (finite_r(vf) ? vf : GS_R(1e6)));
     *z = (gs_real)(up / tot);
     return !(GS_FABS(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
@@ -310,10 +305,40 @@ static NOINLINE gs_real cusum_step(gs_real S, gs_real z)
     return S > GS_R(0.0) ? S : GS_R(0.0);
 }
 
-/* typical frame interval from the history (for time-based spans) */
-static NOINLINE double frame_dt(const gs_flight *f)
+/* typical frame interval from the history (for time-based spans), 1/16 us */
+static NOINLINE uint32_t frame_dt_q4(const gs_flight *f)
 {
-    return gs_dpositive(f->dt_med_s) ? f->dt_med_s : 1.0 / 30.0;
+    return f->dt_med_q4 ? f->dt_med_q4 : DT_DEFAULT_Q4;
+}
+
+/* the same in whole microseconds */
+static int64_t frame_dt_us(const gs_flight *f)
+{
+    return (int64_t)((frame_dt_q4(f) + 8u) >> 4);
+}
+
+/* Frame steps in a span, ceil(span * per_frame / frame interval), where a span within
+ * 1/64 of a step above a whole number counts as that number: sample times are whole
+ * microseconds and the interval a running mean, so a span of exactly k frames comes out a
+ * hair above or below k (an integer division; spans beyond 2^26 / per_frame us give
+ * UINT32_MAX). */
+static NOINLINE uint32_t frame_steps(const gs_flight *f, int64_t span_us, uint32_t per_frame)
+{
+    if (span_us <= 0) return 0;
+    uint64_t num = (uint64_t)span_us * 16u * per_frame;
+    if (num > UINT32_MAX) return UINT32_MAX;
+    uint32_t dt = frame_dt_q4(f), q = (uint32_t)num / dt;
+    return (uint32_t)num - q * dt > dt / 64u ? q + 1u : q;
+}
+
+/* the frame interval follows the stream: a running mean of intervals, in 1/16 us */
+static void track_frame_dt(gs_flight *f, int64_t dt_us)
+{
+    if (dt_us <= 0) return;
+    int32_t dt_q4 = (int32_t)((dt_us < DT_MAX_US ? dt_us : DT_MAX_US) * 16);
+    if (f->dt_med_q4 == 0) f->dt_med_q4 = (uint32_t)dt_q4;
+    else if ((uint32_t)dt_q4 < 3u * f->dt_med_q4)
+        f->dt_med_q4 = (uint32_t)((int32_t)f->dt_med_q4 + (dt_q4 - (int32_t)f->dt_med_q4) / 20);  /* 0.05 */
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
@@ -364,7 +389,7 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
 /* sample s into the running fit */
 static NOINLINE void fit_add(gs_flight *f, const gs_sample_full *s)
 {
-    gs_fit_add(&f->fit, s->t_s, s->x_px, s->y_px, s->w);
+    gs_fit_add(&f->fit, s->t_us, s->x_px, s->y_px, s->w);
 }
 
 /* the oldest sample a flight may reach back to: held, and after the last closed candidate */
@@ -378,14 +403,14 @@ static NOINLINE uint64_t history_floor(const gs_flight *f)
  * when true (scratch otherwise). */
 static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r)
 {
-    double t_lo = t_at(f, lo), t_hi = t_at(f, hi);
-    if (!gs_dfinite(t_lo) || !gs_dfinite(t_hi) || hi <= lo) return false;
+    int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi);
+    if (t_lo == GS_T_NONE || t_hi == GS_T_NONE || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, r) != GS_OK)
         return false;
-    double tspan = t_hi - t_lo;
-    gs_fit_init(&f->fit, 0.5 * (t_lo + t_hi), gs_dgt(tspan, 0.0) ? tspan : frame_dt(f));
+    int64_t tspan = t_hi - t_lo;
+    gs_fit_init(&f->fit, t_lo + tspan / 2, tspan > 0 ? tspan : frame_dt_us(f));
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = usable_at(f, i, &s_b);
@@ -418,10 +443,9 @@ static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge
     return checked == 2;
 }
 
-static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double half_s)
+static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, int64_t half_us)
 {
-    double dt = frame_dt(f);
-    uint32_t half = (uint32_t)ceil_count(half_s / dt - 1e-9);
+    uint32_t half = frame_steps(f, half_us, 1);
     if (half < 2) half = 2;
     uint64_t floor_idx = history_floor(f);
     uint64_t lo = apex > floor_idx + half ? apex - half : floor_idx;
@@ -438,7 +462,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = r.n >= 5 && 4u * r.n >= 3u * n_usable;
     if (!enough || !plausible_fall(f, &r, gate_size(f, apex))) {
-        DBG("seed at %llu (half %.3f) rejected: a=%.1f se=%.1f dir=%.1f\n", (unsigned long long)apex, half_s, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
+        DBG("seed at %llu (half %lld us) rejected: a=%.1f se=%.1f dir=%.1f\n", (unsigned long long)apex, (long long)half_us, r.a_px_s2, r.a_se_px_s2, r.g_dir_deg);
         return false;
     }
     f->fl_first = lo;
@@ -453,9 +477,9 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, double
 /* Seed a flight at an apex: fit a core around it, wider when noise hides the curve. */
 static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
 {
-    static const double half_s[] = {CORE_HALF_S, CORE_HALF_S * 1.45, CORE_HALF_S * 1.9};
-    for (unsigned k = 0; k < sizeof half_s / sizeof half_s[0]; k++)
-        if (seed_core_width(f, apex, newest, half_s[k])) return true;
+    static const int32_t half_us[] = {CORE_HALF_US, CORE_HALF_US * 145 / 100, CORE_HALF_US * 19 / 10};
+    for (unsigned k = 0; k < sizeof half_us / sizeof half_us[0]; k++)
+        if (seed_core_width(f, apex, newest, half_us[k])) return true;
     return false;
 }
 
@@ -505,8 +529,8 @@ static gs_real ssr_left(gs_real yy, const gs_real c[4], const gs_real b[4], int 
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
  * boundary placed inside the flight could absorb flight samples for free. */
-static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, double tc, double ts,
-                            double T, int side, gs_real alpha_min_px, gs_real alpha_max_px,
+static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_lo, int64_t t_hi,
+                            int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px,
                             const gs_fit_result *r)
 {
     /* called per boundary candidate and sample: gs_real. In float, u is taken about
@@ -514,15 +538,18 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
     gs_real A[4][4] = {{0}}, b[4] = {0}, yy = GS_R(0.0);
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
-    gs_real ts2 = (gs_real)(ts * ts);
+    /* tau in [-1, 1] over [t_lo, t_hi]: centre tc, half-width ts */
+    gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
+    gs_real ts2 = ts * ts;
     for (uint64_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         gs_real z;
         const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
         if (!s) continue;  /* gross outliers out */
         gs_real w = (gs_real)s->w;
-        gs_real tau = (gs_real)((s->t_s - tc) / ts);             /* absolute times meet in double */
-        gs_real d = (gs_real)past_s(s->t_s, T, side);
+        /* ((t - t_lo) - (t_hi - t)) / (t_hi - t_lo): exact integer spans in */
+        gs_real tau = gs_time_span_s(s->t_us - t_lo, t_hi - s->t_us) / (ts + ts);
+        gs_real d = gs_time_span_s(past_us(s->t_us, T, side), 0);
         gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
         gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
@@ -534,8 +561,7 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
         yy += w * u * u;
     }
     gs_real c[4];
-    gs_real tsr = (gs_real)ts;
-    gs_real c3_min = alpha_min_px * tsr * tsr, c3_max = alpha_max_px * tsr * tsr;  /* alpha in tau units */
+    gs_real c3_min = alpha_min_px * ts2, c3_max = alpha_max_px * ts2;  /* alpha in tau units */
     bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
     if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
     /* alpha at a bound: fit the parabola to u - alpha h */
@@ -549,30 +575,30 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, doubl
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
  * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
-static double refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
-                              uint64_t edge_in, uint64_t edge_out, gs_real penalty,
-                              const gs_fit_result *r)
+static int64_t refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
+                               uint64_t edge_in, uint64_t edge_out, gs_real penalty,
+                               const gs_fit_result *r)
 {
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
     gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
-    double t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
-    if (!gs_dfinite(t_lo) || !gs_dfinite(t_hi) || !gs_dfinite(t_in) || !gs_dfinite(t_out)) return NAN;
-    double tc = 0.5 * (t_lo + t_hi), ts = 0.5 * (t_hi - t_lo);
-    if (!gs_dgt(ts, 0.0)) return NAN;
+    int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
+    if (t_lo == GS_T_NONE || t_hi == GS_T_NONE || t_in == GS_T_NONE || t_out == GS_T_NONE) return GS_T_NONE;
+    if (t_hi <= t_lo) return GS_T_NONE;
     /* search between the outermost contact sample and a little inside the flight */
-    double dt = frame_dt(f);
-    double inside = gs_dgt(BOUNDARY_IN_S, dt) ? BOUNDARY_IN_S : dt;
-    double t_edge = t_in + (side < 0 ? inside : -inside);
-    double t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
-    int64_t n_steps = ceil_count((t_to - t_from) / dt * BOUNDARY_STEPS);
+    int64_t dt = frame_dt_us(f);
+    int64_t inside = BOUNDARY_IN_US > dt ? BOUNDARY_IN_US : dt;
+    int64_t t_edge = t_in + (side < 0 ? inside : -inside);
+    int64_t t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
+    uint32_t n_steps = frame_steps(f, t_to - t_from, BOUNDARY_STEPS);
     int steps = n_steps < 1 ? 1 : n_steps > 400 ? 400 : (int)n_steps;
+    gs_real span_s = gs_time_span_s(t_to, t_from);
     gs_real best = INFINITY;
-    double best_T = NAN;
+    int64_t best_T = GS_T_NONE;
     for (int k = 0; k <= steps; k++) {
-        double T = t_from + (t_to - t_from) * (double)k / (double)steps;
-        gs_real ssr = piecewise_ssr(f, lo, hi, tc, ts, T, side, alpha_min_px, alpha_max_px, r);
+        int64_t T = gs_time_add_s(t_from, span_s * (gs_real)k / (gs_real)steps);
+        gs_real ssr = piecewise_ssr(f, lo, hi, t_lo, t_hi, T, side, alpha_min_px, alpha_max_px, r);
         /* dropping samples the online test took as flight must pay for itself */
-        if (gs_dlt(past_s(T, t_in, side), 0.0)) ssr += penalty;
+        if (past_us(T, t_in, side) < 0) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
@@ -629,8 +655,8 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     uint32_t outl = 0;
     gs_real S = GS_R(0.0);
     uint64_t floor_idx = history_floor(f);
-    double t_prev = t_at(f, f->fl_first);
-    double t_seed = t_at(f, f->seed_idx);
+    int64_t t_prev = t_at(f, f->fl_first);
+    int64_t t_seed = t_at(f, f->seed_idx);
     uint64_t clean = f->fl_first;
     uint64_t i = f->fl_first;
     while (i > floor_idx) {
@@ -639,9 +665,9 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s) break;
         if (!usable(s)) continue;
-        if (span_over(t_prev, s->t_s, f->cfg->max_gap_s)) break;
-        if (span_over(t_seed, s->t_s, f->cfg->max_flight_s)) break;
-        t_prev = s->t_s;
+        if (span_over(t_prev, s->t_us, f->max_gap_us)) break;
+        if (span_over(t_seed, s->t_us, f->max_flight_us)) break;
+        t_prev = s->t_us;
         gs_real z;
         if (!test_sample(f, r, s, &z)) {
             if (++outl > 2) break;
@@ -702,40 +728,42 @@ static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r,
     return n;
 }
 
-/* The boundary time on one side (NaN: unknown) from the flight's edge and the contact
+/* The boundary time on one side (GS_T_NONE: unknown) from the flight's edge and the contact
  * samples past it (those end where contact was detected, alarm: further out the ground
  * phase is no longer a constant force); *outer = the outermost contact sample. */
-static double boundary_time(const gs_flight *f, const gs_fit_result *r, int side, bool alarm,
+static int64_t boundary_time(const gs_flight *f, const gs_fit_result *r, int side, bool alarm,
                             uint64_t edge, uint64_t other_edge, bool refine, gs_real pen,
                             uint64_t *outer)
 {
     uint64_t first = edge;  /* the first contact sample */
     *outer = edge;
     uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
-    if (!refine) return NAN;
+    if (!refine) return GS_T_NONE;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n >= 2)
         return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
                                side, edge, *outer, pen, r);
-    if (n == 1) return 0.5 * (t_at(f, first) + t_at(f, edge));
-    return NAN;
+    if (n == 1) {
+        int64_t t_first = t_at(f, first), t_edge = t_at(f, edge);  /* both held: L is */
+        return t_edge + (t_first - t_edge) / 2;
+    }
+    return GS_T_NONE;
 }
 
 /* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
  * not beyond the grown edge? (false when not held) */
-static bool inside_edge(const gs_flight *f, uint64_t i, double T, int side, uint64_t edge)
+static bool inside_edge(const gs_flight *f, uint64_t i, int64_t T, int side, uint64_t edge)
 {
-    gs_sample_full s_b;
-    const gs_sample_full *s = at(f, i, &s_b);
-    if (!s) return false;
-    if (!gs_dfinite(T)) return side < 0 ? i >= edge : i <= edge;
-    return gs_dlt(past_s(s->t_s, T, side), 0.0);
+    int64_t t = t_at(f, i);
+    if (t == GS_T_NONE) return false;
+    if (T == GS_T_NONE) return side < 0 ? i >= edge : i <= edge;
+    return past_us(t, T, side) < 0;
 }
 
 /* The flight's outermost sample on one side: from `from` step toward `to` (inward)
  * until a sample is inside the flight (inside_edge) or `to` is reached. */
-static NOINLINE uint64_t trim_edge(const gs_flight *f, uint64_t from, uint64_t to, double T, int side,
+static NOINLINE uint64_t trim_edge(const gs_flight *f, uint64_t from, uint64_t to, int64_t T, int side,
                                    uint64_t edge)
 {
     uint64_t i = from;
@@ -761,7 +789,7 @@ static NOINLINE void restart_levels(gs_flight *f, uint64_t i)
     gs_real u = s ? u_of(f, s) : NAN;
     f->blk_min_cur = finite_r(u) ? u : INFINITY;
     f->blk_min_prev = f->blk_min_cur;
-    f->blk_t0 = s ? s->t_s : NAN;
+    f->blk_t0_us = s ? s->t_us : GS_T_NONE;
     f->peak_u = -INFINITY;
     f->n_hist = 0;
 }
@@ -772,7 +800,6 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
 {
     uint64_t land_idx = UINT64_MAX;  /* first sample after the flight */
     gs_fit_result r;
-    double dt = frame_dt(f);
     if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
     uint64_t left_alarm = grow_left(f, &r);
 
@@ -790,11 +817,11 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     gs_real sig = fit_sigma(f, &r);
     gs_real pen = DROP_PENALTY * sig * sig;
     uint64_t lo, hi;  /* the outermost contact samples */
-    double T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
-    double T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
-    DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%.4f T1=%.4f a=%.1f\n",
+    int64_t T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
+    int64_t T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
+    DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
-        T0, T1, r.a_px_s2);
+        (long long)T0, (long long)T1, r.a_px_s2);
     /* flight samples: strictly inside (T0, T1) */
     uint64_t in_lo = trim_edge(f, lo, hi, T0, -1, L);
     uint64_t in_hi = trim_edge(f, hi, in_lo, T1, +1, R);
@@ -810,28 +837,28 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
                                  f->keep, &fr);
-    trace_fit(f, "final", sf->t_s, sl->t_s, st == GS_OK ? &fr : NULL);
+    trace_fit(f, "final", sf->t_us, sl->t_us, st == GS_OK ? &fr : NULL);
     if (st != GS_OK) goto done;  /* nothing fits: not a flight worth reporting */
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
-    double max_gap_in = 0.0;
-    double t_prev = NAN;
+    int64_t max_gap_in = 0;
+    int64_t t_prev = GS_T_NONE;
     for (uint64_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
-        if (!s || !(s->w > 0.0f) || !gs_dfinite(s->t_s)) continue;  /* frames missing from the source */
-        if (gs_dfinite(t_prev) && gs_dgt(s->t_s - t_prev, max_gap_in)) max_gap_in = s->t_s - t_prev;
-        t_prev = s->t_s;
+        if (!s || !(s->w > 0.0f)) continue;  /* frames missing from the source */
+        if (t_prev != GS_T_NONE && s->t_us - t_prev > max_gap_in) max_gap_in = s->t_us - t_prev;
+        t_prev = s->t_us;
         if (!usable(s)) continue;
         n_in++;
         if (!gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    double half_dt = 0.5 * dt;
-    if (!gs_dfinite(T0)) T0 = sf->t_s - half_dt;
-    if (!gs_dfinite(T1)) T1 = sl->t_s + half_dt;
+    int64_t half_dt = frame_dt_us(f) / 2;
+    if (T0 == GS_T_NONE) T0 = sf->t_us - half_dt;
+    if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -839,9 +866,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     gs_ev_jump *j = &ev.u.jump;
     j->index = f->n_flights;
     j->track = f->track;
-    j->t_takeoff_s = T0;
-    j->t_land_s = T1;
-    j->flight_time_s = T1 - T0;
+    j->t_takeoff_us = T0;
+    j->t_land_us = T1;
+    j->flight_time_s = gs_time_span_s(T1, T0);
     j->n_samples = n_in;
     j->n_outliers = n_out;
     j->height_m = j->height_se_m = NAN;  /* the other fields are all set below (memset: not accepted, no reason) */
@@ -861,8 +888,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         /* apex: where the velocity along gravity is zero */
         gs_real gx = fr.ax_px_s2 / fr.a_px_s2, gy = fr.ay_px_s2 / fr.a_px_s2;
         gs_real v_down = fr.vx_px_s * gx + fr.vy_px_s * gy;
-        j->t_apex_s = fr.t0_s - v_down / fr.a_px_s2;
-        gs_real rise_t = j->t_apex_s - T0;
+        gs_real apex_s = -v_down / fr.a_px_s2;  /* after the fit's t0 */
+        j->t_apex_us = gs_time_add_s(fr.t0_us, apex_s);
+        gs_real rise_t = gs_time_span_s(fr.t0_us, T0) + apex_s;
         j->jump_height_m = GS_R(0.5) * g * rise_t * rise_t;
         j->takeoff_velocity_m_s = g * rise_t;
         if (finite_r(size)) {
@@ -877,9 +905,9 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         bool flight_like = plausible_fall(f, &fr, size);
         if (!flight_like) goto done;
 
-        if (n_in < f->cfg->min_samples || (gs_real)j->flight_time_s < (gs_real)f->cfg->min_flight_s)
+        if (n_in < f->cfg->min_samples || T1 - T0 < f->min_flight_us)
             j->reason = GS_REJ_FEW_SAMPLES;
-        else if (gs_dgt(max_gap_in, (double)f->cfg->max_gap_s))
+        else if (max_gap_in > f->max_gap_us)
             j->reason = GS_REJ_GAP;
         else if (!finite_r(size))
             j->reason = GS_REJ_NO_SIZE;
@@ -926,16 +954,16 @@ done:
 
 static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s);
 
-/* |du/dt| against the sample about 0.1 s back (frame jitter is not motion); NaN unknown */
-static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u)
+/* |du/dt| against the sample about lag_us back (frame jitter is not motion); NaN unknown */
+static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u, int64_t lag_us)
 {
-    uint64_t k = (uint64_t)ceil_count(0.1 / frame_dt(f));
+    uint64_t k = frame_steps(f, lag_us, 1);
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
     const gs_sample_full *b = usable_at(f, idx - k, &b_b);
-    if (!b || !gs_dgt(s->t_s, b->t_s)) return NAN;
-    return GS_FABSR(u - u_of(f, b)) / (gs_real)(s->t_s - b->t_s);
+    if (!b || s->t_us <= b->t_us) return NAN;
+    return GS_FABSR(u - u_of(f, b)) / gs_time_span_s(s->t_us, b->t_us);
 }
 
 /* keep size in a ring of the last GS_STAND_KEEP */
@@ -951,15 +979,15 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     if (!finite_r(speed)) return;
     if (IS_RIGID(f) || !size_ok(s->size_px)) return;
     /* stillness is broken by motion only; uprightness is judged frame by frame */
-    if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since = NAN; return; }
-    if (!gs_dfinite(f->still_since)) f->still_since = s->t_s;
+    if (!(speed < STAND_SPEED_REL * (gs_real)s->size_px)) { f->still_since_us = GS_T_NONE; return; }
+    if (f->still_since_us == GS_T_NONE) f->still_since_us = s->t_us;
     if (s->upright >= LOOSE_UPRIGHT) {
         keep_size(f->loose_size, &f->loose_n, &f->loose_next, s->size_px);
     }
     if (!(s->upright >= STAND_UPRIGHT)) return;
-    if (gs_dlt(s->t_s - f->still_since, STAND_SETTLE_S)) return;  /* settled, not rising onto the toes */
+    if (s->t_us - f->still_since_us < STAND_SETTLE_US) return;  /* settled, not rising onto the toes */
     keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
-    f->stand_last_t = s->t_s;
+    f->stand_last_us = s->t_us;
     /* body axis -> image up, until flights measure gravity directly */
     if (!f->up_from_flight && finite_r(s->up_x) && finite_r(s->up_y)) {
         gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
@@ -977,10 +1005,10 @@ static float last_stand_size(const gs_flight *f)
     return f->stand_size[(f->stand_next + GS_STAND_KEEP - 1u) % GS_STAND_KEEP];
 }
 
-double gs_flight_stand_at(const gs_flight *f, double t_s)
+gs_real gs_flight_stand_at(const gs_flight *f, int64_t t_us)
 {
-    /* the ring gives times back to the microsecond: same frame within half a millisecond */
-    if (!f || f->stand_n == 0 || !gs_dlt(fabs(f->stand_last_t - t_s), 5e-4)) return NAN;
+    /* the ring gives times back exactly: the same frame has the same time */
+    if (!f || f->stand_n == 0 || f->stand_last_us != t_us || t_us == GS_T_NONE) return NAN;
     return (gs_real)last_stand_size(f);
 }
 
@@ -989,8 +1017,8 @@ void gs_flight_forget_body(gs_flight *f)
     if (!f) return;
     f->stand_n = f->stand_next = 0;
     f->loose_n = f->loose_next = 0;
-    f->stand_last_t = NAN;
-    f->still_since = NAN;
+    f->stand_last_us = GS_T_NONE;
+    f->still_since_us = GS_T_NONE;
     if (!f->up_from_flight) f->up_n = 0;
 }
 
@@ -1008,24 +1036,24 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     if (f->n_hist == 3) {
         f->u_hist[0] = f->u_hist[1]; f->u_hist[1] = f->u_hist[2];
         f->i_hist[0] = f->i_hist[1]; f->i_hist[1] = f->i_hist[2];
-        f->t_hist[0] = f->t_hist[1]; f->t_hist[1] = f->t_hist[2];
+        f->t_hist_us[0] = f->t_hist_us[1]; f->t_hist_us[1] = f->t_hist_us[2];
         f->n_hist = 2;
     }
     f->u_hist[f->n_hist] = u_of(f, s);
     f->i_hist[f->n_hist] = idx;
-    f->t_hist[f->n_hist] = s->t_s;
+    f->t_hist_us[f->n_hist] = s->t_us;
     f->n_hist++;
     if (f->n_hist < 3) return;
 
     gs_real um = med3(f->u_hist[0], f->u_hist[1], f->u_hist[2]);
     uint64_t im = f->i_hist[1];
-    double tm = f->t_hist[1];
+    int64_t tm = f->t_hist_us[1];
     gs_real d2 = f->u_hist[2] - GS_R(2.0) * f->u_hist[1] + f->u_hist[0];
     gs_real sz = size_ref(f, s);
 
     /* keypoint noise, not motion: judged while nearly still (contact phases of a
      * jump series would otherwise pass for noise) */
-    gs_real speed = speed_px_s(f, idx, s, f->u_hist[2]);
+    gs_real speed = speed_px_s(f, idx, s, f->u_hist[2], SPEED_LAG_US);
     /* size_ref(f, s) again would be sz: nothing between changes what it reads */
     /* sz is positive or NaN (unknown: any finite speed counts) */
     bool still = finite_r(speed) && !(speed >= STAND_SPEED_REL * sz);
@@ -1045,14 +1073,14 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         if (a > GS_R(3.0) * f->noise_px) a = GS_R(3.0) * f->noise_px;
         f->noise_px += GS_R(0.02) * (a - f->noise_px);
     }
-    update_standing(f, s, speed);
+    update_standing(f, s, speed_px_s(f, idx, s, f->u_hist[2], STAND_LAG_US));
 
     /* recent minimum over two half-second blocks */
-    if (!gs_dfinite(f->blk_t0)) f->blk_t0 = tm;
-    if (gs_dgt(tm - f->blk_t0, 0.5)) {
+    if (f->blk_t0_us == GS_T_NONE) f->blk_t0_us = tm;
+    if (tm - f->blk_t0_us > LEVEL_BLOCK_US) {
         f->blk_min_prev = f->blk_min_cur;
         f->blk_min_cur = INFINITY;
-        f->blk_t0 = tm;
+        f->blk_t0_us = tm;
     }
     if (um < f->blk_min_cur) f->blk_min_cur = um;
     gs_real umin = f->blk_min_cur < f->blk_min_prev ? f->blk_min_cur : f->blk_min_prev;
@@ -1060,19 +1088,19 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     gs_real nz = noise_floor(f);
     gs_real thr = SEED_RISE_NOISE * nz;
     if (SEED_RISE_REL * sz > thr) thr = SEED_RISE_REL * sz;  /* false for an unknown (NaN) size */
-    DBG("g t=%.3f um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", tm, um, umin, thr, nz, sz, f->peak_u);
+    DBG("g t=%lld um=%.1f umin=%.1f thr=%.1f noise=%.2f sz=%.1f peak=%.1f\n", (long long)tm, um, umin, thr, nz, sz, f->peak_u);
     /* a peak counts once it rose thr above the recent minimum; the drop that
      * confirms it as an apex seeds a flight, however far it has fallen by then */
     if (!finite_r(f->peak_u)) {
-        if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; }
+        if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; f->peak_t_us = tm; }
         return;
     }
-    if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t = tm; return; }
+    if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t_us = tm; return; }
     gs_real drop = SEED_DROP_NOISE * nz;
     if (GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
     if (f->peak_u - um <= drop) return;
     uint64_t apex = f->peak_idx;
-    double apex_t = f->peak_t;
+    int64_t apex_t = f->peak_t_us;
     f->peak_u = -INFINITY;
     if (seed_core(f, apex, idx)) {
         set_state(f, GS_FS_AIRBORNE, apex_t);
@@ -1091,14 +1119,14 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_ful
     gs_fit_result r;
     refit_range(f, f->fl_first, f->fl_last, &r);
     close_candidate(f, idx, alarm, false);
-    set_state(f, GS_FS_GROUND, s->t_s);
+    set_state(f, GS_FS_GROUND, s->t_us);
 }
 
 static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
-    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_s, t_at(f, f->seed_idx), f->cfg->max_flight_s)) {
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_us, t_at(f, f->seed_idx), f->max_flight_us)) {
         land(f, idx, UINT64_MAX, s);
         return;
     }
@@ -1110,7 +1138,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     if (k >= 32) { land(f, idx, UINT64_MAX, s); return; }
     gs_real z;
     bool ok = test_sample(f, &r, s, &z);
-    DBG("t=%.4f ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", s->t_s, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
+    DBG("t=%lld ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", (long long)s->t_us, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
         if (++f->outliers_run >= 3) land(f, idx, UINT64_MAX, s);
         return;
@@ -1118,7 +1146,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    if (f->cusum > GS_R(0.0) && span_over(s->t_s, t_at(f, f->fl_last), f->cfg->landing_latency_s)) {
+    if (f->cusum > GS_R(0.0) && span_over(s->t_us, t_at(f, f->fl_last), f->landing_latency_us)) {
         land(f, idx, idx, s);
         return;
     }
@@ -1157,26 +1185,23 @@ void gs_flight_update(gs_flight *f)
         const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
-        bool present = s && s->w > 0.0f && gs_dfinite(s->t_s);
-        if (present && !usable(s)) { f->last_t_s = s->t_s; continue; }
+        bool present = s && s->w > 0.0f;
+        if (present && !usable(s)) { f->last_t_us = s->t_us; continue; }
         if (!present) continue;
-        if (gs_dfinite(f->last_t_s)) {
-            double dt = s->t_s - f->last_t_s;
-            if (gs_dgt(dt, 0.0)) {
-                if (!gs_dfinite(f->dt_med_s)) f->dt_med_s = dt;
-                else if (gs_dlt(dt, 3.0 * f->dt_med_s)) f->dt_med_s += 0.05 * (dt - f->dt_med_s);
-            }
-            if (gs_dgt(dt, (double)f->cfg->max_gap_s)) {
+        if (f->last_t_us != GS_T_NONE) {
+            int64_t dt = s->t_us - f->last_t_us;
+            track_frame_dt(f, dt);
+            if (dt > f->max_gap_us) {
                 if (f->state == GS_FS_AIRBORNE) {
                     close_candidate(f, f->last_idx, UINT64_MAX, true);
                 }
                 restart_levels(f, UINT64_MAX);  /* never held: from nothing */
-                set_state(f, GS_FS_GROUND, s->t_s);
+                set_state(f, GS_FS_GROUND, s->t_us);
             }
         }
-        f->last_t_s = s->t_s;
+        f->last_t_us = s->t_us;
         f->last_idx = idx;
-        if (f->state == GS_FS_IDLE) set_state(f, GS_FS_GROUND, s->t_s);
+        if (f->state == GS_FS_IDLE) set_state(f, GS_FS_GROUND, s->t_us);
         if (f->state == GS_FS_AIRBORNE) airborne_sample(f, idx, s);
         else ground_sample(f, idx, s);
     }
@@ -1188,7 +1213,7 @@ void gs_flight_break(gs_flight *f)
     /* what the next sample would do on seeing the gap, while the ring still holds the flight */
     if (f->state == GS_FS_AIRBORNE) {
         close_candidate(f, f->last_idx, UINT64_MAX, true);
-        set_state(f, GS_FS_GROUND, f->last_t_s);
+        set_state(f, GS_FS_GROUND, f->last_t_us);
     }
 }
 
@@ -1197,6 +1222,6 @@ void gs_flight_finish(gs_flight *f)
     gs_flight_update(f);
     if (f->state == GS_FS_AIRBORNE) {
         close_candidate(f, f->last_idx, UINT64_MAX, true);
-        set_state(f, GS_FS_GROUND, f->last_t_s);
+        set_state(f, GS_FS_GROUND, f->last_t_us);
     }
 }

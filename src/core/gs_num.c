@@ -2,7 +2,8 @@
  * Parsing: a fast path (a mantissa <= 2^53 times an exact power of ten: one
  * rounding) and an exact big-integer path for the rest: correctly rounded. Formatting: exact decimal digits of the
  * binary value from a big integer, rounded half away from zero.
- * double: it is the number format of the lines (event fields are double). */
+ * Times (integer microseconds) are formatted from their decimal digits, with the
+ * same digit writer. */
 #include "gravscale/gs_num.h"
 
 #include <limits.h>
@@ -444,6 +445,18 @@ typedef struct {
     int p;
 } gs_dec;
 
+/* the decimal digits of n > 0 (consumed) into d, worth n * 10^-p */
+static void dec_digits(gs_big *n, int p, gs_dec *d)
+{
+    d->p = p;
+    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower) */
+    d->nd = 0;
+    while (n->n)
+        for (uint32_t r = big_divmod_small(n, 10000u), j = 0; j < 4; j++, r /= 10u)
+            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
+    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
+}
+
 static void dec_expand(uint64_t abs_bits, gs_dec *d)
 {
     /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
@@ -462,17 +475,11 @@ static void dec_expand(uint64_t abs_bits, gs_dec *d)
     big_set(&n, mant);
     /* a = mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
     uint32_t k = (uint32_t)(e2 < 0 ? -e2 : e2);
-    d->p = e2 < 0 ? (int)k : 0;
     for (; k; k -= k < 13u ? k : 13u) {
         uint32_t step = k < 13u ? k : 13u;
         (void)big_mul_add(&n, e2 < 0 ? k_pow5_u32[step] : 1u << step, 0);
     }
-    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower) */
-    d->nd = 0;
-    while (n.n)
-        for (uint32_t r = big_divmod_small(&n, 10000u), j = 0; j < 4; j++, r /= 10u)
-            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
-    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
+    dec_digits(&n, e2 < 0 ? -e2 : 0, d);
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -530,22 +537,43 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
     return n;
 }
 
+/* |value| = D * 10^-p from d (NULL: 0) with `decimals` decimals, rounded half away
+ * from zero, a minus sign when neg and the rounded value is not 0 */
+static size_t fmt_dec(char *buf, size_t cap, const gs_dec *d, bool neg, int decimals)
+{
+    char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
+    int nr = 0;
+    if (d) {
+        int count = d->nd - d->p + decimals; /* digits at or above 10^-decimals */
+        if (count >= 0) nr = count + dec_round(d, count, dig);
+    }
+    char t[48];
+    size_t n = put_digits(t, nr && neg, dig, nr, nr - decimals, decimals);
+    return put_out(buf, cap, t, n);
+}
+
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
     if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
-    char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
-    int nr = 0;
+    gs_dec d;
+    if (mag) dec_expand(mag, &d);
+    return fmt_dec(buf, cap, mag ? &d : NULL, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+}
+
+size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
+{
+    if (t_us == INT64_MIN || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
+    uint64_t mag = t_us < 0 ? (uint64_t)-t_us : (uint64_t)t_us;
+    gs_dec d;
     if (mag) {
-        gs_dec d;
-        dec_expand(mag, &d);
-        int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
-        if (count >= 0) nr = count + dec_round(&d, count, dig);
+        /* the digits by 32-bit divisions: no 64-bit division routine linked */
+        gs_big n;
+        big_set(&n, mag);
+        dec_digits(&n, 6, &d);
     }
-    char t[48];
-    size_t n = put_digits(t, nr && (gs_dbits(v) & GS_DBITS_SIGN), dig, nr, nr - decimals, decimals);
-    return put_out(buf, cap, t, n);
+    return fmt_dec(buf, cap, mag ? &d : NULL, t_us < 0, decimals);
 }
 
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)

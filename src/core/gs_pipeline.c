@@ -1,5 +1,6 @@
 /* gs_pipeline.c - keypoints -> COM sample -> ring -> flights -> aggregate -> events.
- * double: the caller's timestamps (absolute; the ring keeps 32-bit microseconds). */
+ * Times are the caller's microseconds (the ring keeps them modulo 2^32 from a base);
+ * the double-seconds entry points only convert at the edge (hosts). */
 #include "gravscale/gs_pipeline.h"
 
 #include <math.h>
@@ -68,7 +69,7 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     p->layout = layout;
     p->on_event = on_event;
     p->ctx = ctx;
-    p->last_t_s = NAN;
+    p->last_t_us = GS_T_NONE;
     uint32_t cap = cfg->ring_capacity;
     gs_sample *samples = (gs_sample *)storage;
     uint32_t *scratch = (uint32_t *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
@@ -76,7 +77,8 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     if (st != GS_OK) return st;
     gs_agg_init(&p->agg);
     p->sessions = GS_WITH_POSE && layout != GS_LAYOUT_POINT;
-    if (GS_WITH_POSE) gs_session_init(&p->session, (double)cfg->session_absence_s, (double)cfg->session_new_body_rel);
+    if (GS_WITH_POSE)
+        gs_session_init(&p->session, gs_time_us_of_cfg_s(cfg->session_absence_s), (gs_real)cfg->session_new_body_rel);
     return gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
                           on_flight_event, p);
 }
@@ -114,13 +116,13 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
 {
     bool present = s->w >= 0.05f && isfinite(s->x_px) && isfinite(s->y_px);
     const char *why = NULL;
-    uint32_t r = gs_session_frame(&p->session, s->t_s, present, gs_flight_stand_at(&p->flight, s->t_s), &why);
+    uint32_t r = gs_session_frame(&p->session, s->t_us, present, gs_flight_stand_at(&p->flight, s->t_us), &why);
     if (r & GS_SESSION_ENDED) {
         emit_session(p, true, why);
         gs_session_close(&p->session);
         gs_agg_init(&p->agg);
         gs_flight_forget_body(&p->flight);
-        if (present) r = gs_session_frame(&p->session, s->t_s, present, NAN, &why);
+        if (present) r = gs_session_frame(&p->session, s->t_us, present, (gs_real)NAN, &why);
     }
     if (r & GS_SESSION_STARTED) emit_session(p, false, NULL);
 }
@@ -128,30 +130,26 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
 static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
 {
     if (p->finished) return GS_ESTATE;
-    if (!gs_dfinite(s->t_s)) return GS_EINVAL;
-    if (gs_dfinite(p->last_t_s)) {
-        int order = gs_dcmp(s->t_s, p->last_t_s);  /* both finite: -1, 0 or 1 */
-        if (order < 0) return GS_EORDER;
-        if (order == 0) return GS_OK;  /* a repeated frame carries nothing new */
+    if (s->t_us == GS_T_NONE) return GS_EINVAL;
+    if (p->last_t_us != GS_T_NONE) {
+        if (s->t_us < p->last_t_us) return GS_EORDER;
+        if (s->t_us == p->last_t_us) return GS_OK;  /* a repeated frame carries nothing new */
     }
-    int64_t us = gs_ring_time_us(&p->ring, s->t_s);
-    if (us == INT64_MIN) return GS_ERANGE;
-    if (p->n_frames > 0) {
-        /* the ring keeps whole microseconds: a frame within the same one adds nothing */
-        if (us <= p->ring.t_last_us) return GS_OK;
-        /* after a gap beyond the ring's time span its samples leave it: a flight
-         * left open must close on them first (as it would on any long gap) */
-        if (us - p->ring.t_last_us >= GS_RING_SPAN_US) gs_flight_break(&p->flight);
-    }
+    if (!gs_time_ok(s->t_us)) return GS_ERANGE;
+    /* after a gap beyond the ring's time span its samples leave it: a flight
+     * left open must close on them first (as it would on any long gap); the
+     * difference as uint64 is exact for any two accepted times */
+    if (p->last_t_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)p->last_t_us >= (uint64_t)GS_RING_SPAN_US)
+        gs_flight_break(&p->flight);
     gs_status st = gs_ring_push(&p->ring, s);
     if (st != GS_OK) return st;
-    p->last_t_s = s->t_s;
+    p->last_t_us = s->t_us;
     p->n_frames++;
     if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
         ev.type = GS_EV_SAMPLE;
-        ev.u.sample.t_s = s->t_s;
+        ev.u.sample.t_us = s->t_us;
         ev.u.sample.x_px = s->x_px;
         ev.u.sample.y_px = s->y_px;
         ev.u.sample.w = s->w;
@@ -164,14 +162,14 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
     return GS_OK;
 }
 
-gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp)
+gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp)
 {
     if (!p || !kp) return GS_EINVAL;
     gs_com_out c;
     gs_status st = gs_com_compute(p->layout, p->cfg.mass_table, p->cfg.stature, p->cfg.min_conf, kp, &c);
     if (st != GS_OK) return st;
     gs_sample_full s;
-    s.t_s = t_s;
+    s.t_us = t_us;
     s.x_px = c.x_px;
     s.y_px = c.y_px;
     s.w = (isfinite(c.x_px) && isfinite(c.y_px)) ? c.w : 0.0f;
@@ -182,12 +180,12 @@ gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp
     return push_sample(p, &s);
 }
 
-gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px,
-                                 float c, float size_px)
+gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, float y_px,
+                                    float c, float size_px)
 {
     if (!p) return GS_EINVAL;
     gs_sample_full s;
-    s.t_s = t_s;
+    s.t_us = t_us;
     s.x_px = x_px;
     s.y_px = y_px;
     s.w = (isfinite(x_px) && isfinite(y_px) && c > 0.0f) ? (c < 1.0f ? c : 1.0f) : 0.0f;
@@ -196,6 +194,26 @@ gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y
     s.up_y = NAN;
     s.upright = 1.0f;
     return push_sample(p, &s);
+}
+
+/* t_s in microseconds for push_sample: not finite -> GS_T_NONE (GS_EINVAL); finite
+ * beyond the range -> +-INT64_MAX, which meet the order check as before and then
+ * are refused (GS_ERANGE) */
+static int64_t edge_us(double t_s)
+{
+    int64_t t_us = gs_time_us_of_s(t_s);
+    if (t_us != GS_T_NONE || !gs_dfinite(t_s)) return t_us;
+    return (gs_dbits(t_s) & GS_DBITS_SIGN) ? -INT64_MAX : INT64_MAX;
+}
+
+gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp)
+{
+    return gs_pipeline_push_keypoints_us(p, edge_us(t_s), kp);
+}
+
+gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px, float c, float size_px)
+{
+    return gs_pipeline_push_point_us(p, edge_us(t_s), x_px, y_px, c, size_px);
 }
 
 gs_status gs_pipeline_flush(gs_pipeline *p)

@@ -4,15 +4,11 @@
 
 #include <math.h>
 
-#include "gs_dbits.h"
-
 #define SIZE_FINE_Q 0x8000u      /* codes below: 1/16 px steps */
 #define SIZE_FINE_PX 2048.0f     /* ... up to here, then 1/4 px steps */
 #define SIZE_UNKNOWN 0xFFFFu
 #define UPRIGHT_STEPS 250.0f
 #define UPRIGHT_UNKNOWN 255u
-/* Beyond 2^62 us (146 000 years) from the base a time is refused: int64 stays safe. */
-#define TIME_MAX_US 4.6e18
 
 gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
 {
@@ -24,28 +20,10 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity)
     r->mask = capacity - 1u;
     r->head = 0;
     r->valid_from = 0;
-    r->t_base_s = (double)NAN;
-    r->t_last_us = 0;
+    r->t_last_us = GS_T_NONE;
     r->last_up_x = NAN;
     r->last_up_y = NAN;
     return GS_OK;
-}
-
-int64_t gs_ring_time_us(const gs_ring *r, double t_s)
-{
-    if (!r || !gs_dfinite(t_s)) {
-        return INT64_MIN;
-    }
-    /* the first sample becomes the base; double because it is an absolute time */
-    double base = gs_dfinite(r->t_base_s) ? r->t_base_s : t_s;
-    double us = (t_s - base) * 1e6;
-    double mag_us = fabs(us);
-    if (!gs_dlt(mag_us, TIME_MAX_US)) {
-        return INT64_MIN;
-    }
-    /* round half away from zero without libm's llround: the magnitude, then the sign */
-    int64_t n = (int64_t)gs_dtrunc_abs(mag_us + 0.5);
-    return signbit(us) ? -n : n;
 }
 
 static uint16_t size_pack(float size_px)
@@ -118,40 +96,36 @@ float gs_sample_upright(const gs_sample *s)
 
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
 {
-    if (!r || !s || !r->buf) {
+    if (!r || !s || !r->buf || !gs_time_ok(s->t_us)) {
         return GS_EINVAL;
     }
-    int64_t us = gs_ring_time_us(r, s->t_s);
-    if (us == INT64_MIN) {
-        return GS_EINVAL;
-    }
-    bool first = !gs_dfinite(r->t_base_s);
-    if (!first && us < r->t_last_us) {
-        return GS_EORDER;
-    }
-    if (first) {
-        r->t_base_s = s->t_s;
-        us = 0;
-    } else if (us - r->t_last_us >= GS_RING_SPAN_US) {
-        r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
-    } else {
-        /* ages are exact below 2^32 us: drop the samples that reached the span */
-        uint32_t lo = (uint32_t)us;
-        uint64_t oldest = gs_ring_oldest(r);
-        while (oldest < r->head &&
-               (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
-            oldest++;
+    int64_t t = s->t_us;
+    if (r->t_last_us != GS_T_NONE) {
+        if (t < r->t_last_us) {
+            return GS_EORDER;
         }
-        r->valid_from = oldest;
+        /* t - newest as uint64: exact for any two accepted times (up to 2^63) */
+        if ((uint64_t)t - (uint64_t)r->t_last_us >= (uint64_t)GS_RING_SPAN_US) {
+            r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
+        } else {
+            /* ages are exact below 2^32 us: drop the samples that reached the span */
+            uint32_t lo = (uint32_t)(uint64_t)t;
+            uint64_t oldest = gs_ring_oldest(r);
+            while (oldest < r->head &&
+                   (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
+                oldest++;
+            }
+            r->valid_from = oldest;
+        }
     }
     gs_sample *d = &r->buf[(uint32_t)(r->head & r->mask)];
-    d->t_us = (uint32_t)us;  /* modulo 2^32: read back relative to the newest */
+    d->t_us = (uint32_t)(uint64_t)t;  /* modulo 2^32: read back relative to the newest */
     d->x_px = s->x_px;
     d->y_px = s->y_px;
     d->size_q = size_pack(s->size_px);
     d->w_q = w_pack(s->w);
     d->upright_q = upright_pack(s->upright);
-    r->t_last_us = us;
+    r->t_last_us = t;
     r->last_up_x = s->up_x;
     r->last_up_y = s->up_y;
     r->head++;
@@ -188,14 +162,12 @@ const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i)
     return &r->buf[(uint32_t)(i & r->mask)];
 }
 
-double gs_ring_sample_t_s(const gs_ring *r, const gs_sample *s)
+int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s)
 {
     /* held samples are less than 2^31 us older than the newest: the modular
      * difference is their exact age, across any wrap of the 32-bit field */
-    uint32_t age = (uint32_t)r->t_last_us - s->t_us;
-    int64_t us = r->t_last_us - (int64_t)age;
-    /* double: an absolute time of a stream that may run for days */
-    return r->t_base_s + (double)us / 1e6;
+    uint32_t age = (uint32_t)(uint64_t)r->t_last_us - s->t_us;
+    return r->t_last_us - (int64_t)age;  /* the time that was pushed: no overflow */
 }
 
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)
@@ -204,7 +176,7 @@ bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)
     if (!s || !out) {
         return false;
     }
-    out->t_s = gs_ring_sample_t_s(r, s);
+    out->t_us = gs_ring_sample_t_us(r, s);
     out->x_px = s->x_px;
     out->y_px = s->y_px;
     out->w = gs_sample_w(s);

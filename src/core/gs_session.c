@@ -4,31 +4,30 @@
 #include <math.h>
 #include <string.h>
 
-#include "gs_dbits.h"
-
+#define GAP_MAX_US 500000  /* an absence this long (or the absence limit, when shorter) is a gap */
 #define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
 
 /* the per-visit state: every field from gap_since_ref to the end (gs_session.h) */
 static void reset_visit(gs_session *s)
 {
     memset(&s->gap_since_ref, 0, sizeof *s - offsetof(gs_session, gap_since_ref));
-    s->ref_px = NAN;
-    s->best_jump_m = s->best_flight_s = NAN;
+    s->ref_px = (gs_real)NAN;
+    s->best_jump_m = s->best_flight_s = (gs_real)NAN;
 }
 
-void gs_session_init(gs_session *s, double absence_s, double new_body_rel)
+void gs_session_init(gs_session *s, int64_t absence_us, gs_real new_body_rel)
 {
     if (!s) return;
     memset(s, 0, sizeof *s);
-    s->absence_s = absence_s;
+    s->absence_us = absence_us;
     s->new_body_rel = new_body_rel;
-    s->gap_s = gs_dlt(absence_s, 0.5) ? absence_s : 0.5;
-    s->t_start_s = s->t_seen_s = NAN;
+    s->gap_us = absence_us < GAP_MAX_US ? absence_us : GAP_MAX_US;
+    s->t_start_us = s->t_seen_us = GS_T_NONE;
     reset_visit(s);
 }
 
 /* the median of GS_SESSION_REF_N sizes */
-static double median_ref(const float *v)
+static gs_real median_ref(const float *v)
 {
     const uint32_t n = GS_SESSION_REF_N;
     float t[GS_SESSION_REF_N];
@@ -41,40 +40,50 @@ static double median_ref(const float *v)
         }
         t[j] = x;
     }
-    return (n & 1u) ? (double)t[n / 2] : 0.5 * ((double)t[n / 2 - 1] + (double)t[n / 2]);
+    return (n & 1u) ? (gs_real)t[n / 2] : GS_R(0.5) * ((gs_real)t[n / 2 - 1] + (gs_real)t[n / 2]);
 }
 
-static uint32_t start(gs_session *s, double t_s)
+static uint32_t start(gs_session *s, int64_t t_us)
 {
     s->id++;
     s->open = true;
-    s->t_start_s = s->t_seen_s = t_s;
+    s->t_start_us = s->t_seen_us = t_us;
     reset_visit(s);
     return GS_SESSION_STARTED;
 }
 
-uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_px, const char **end_reason)
+/* t is at least span after t0 (an earlier t never is); the difference as uint64 is
+ * exact for any two times, where int64 would overflow */
+static bool elapsed(int64_t t_us, int64_t t0_us, int64_t span_us)
 {
-    if (!s || !gs_dfinite(t_s)) return 0;
+    return t_us >= t0_us && (span_us <= 0 || (uint64_t)t_us - (uint64_t)t0_us >= (uint64_t)span_us);
+}
+
+/* finite and > 0 */
+static bool positive(gs_real x) { return x > GS_R(0.0) && x < (gs_real)INFINITY; }
+
+uint32_t gs_session_frame(gs_session *s, int64_t t_us, bool present, gs_real stand_px, const char **end_reason)
+{
+    if (!s || t_us == GS_T_NONE) return 0;
     if (end_reason) *end_reason = NULL;
     if (!present) {
-        if (s->open && gs_dge(t_s - s->t_seen_s, s->absence_s)) {
+        if (s->open && elapsed(t_us, s->t_seen_us, s->absence_us)) {
             if (end_reason) *end_reason = "absence";
             return GS_SESSION_ENDED;  /* the caller emits the end, then gs_session_close */
         }
         return 0;
     }
-    if (!s->open) return start(s, t_s);
-    if (gs_dge(t_s - s->t_seen_s, s->gap_s) && s->ref_n >= GS_SESSION_REF_N) s->gap_since_ref = true;
-    s->t_seen_s = t_s;
-    if (!gs_dpositive(stand_px)) return 0;
+    if (!s->open) return start(s, t_us);
+    if (elapsed(t_us, s->t_seen_us, s->gap_us) && s->ref_n >= GS_SESSION_REF_N) s->gap_since_ref = true;
+    s->t_seen_us = t_us;
+    if (!positive(stand_px)) return 0;
     if (s->ref_n < GS_SESSION_REF_N) {
         s->ref_acc[s->ref_n++] = (float)stand_px;
         if (s->ref_n == GS_SESSION_REF_N) s->ref_px = median_ref(s->ref_acc);
         return 0;
     }
     /* the same person stepping closer changes size while seen; someone else appears after a gap */
-    if (s->gap_since_ref && gs_dgt(fabs(stand_px / s->ref_px - 1.0), s->new_body_rel)) {
+    if (s->gap_since_ref && GS_FABSR(stand_px / s->ref_px - GS_R(1.0)) > s->new_body_rel) {
         if (++s->odd_run >= ODD_RUN_NEEDED) {
             if (end_reason) *end_reason = "new_body";
             return GS_SESSION_ENDED;
@@ -86,12 +95,12 @@ uint32_t gs_session_frame(gs_session *s, double t_s, bool present, double stand_
 }
 
 /* a known value into a sum and its count, and into the best (largest) when given */
-static void tally(double x, double *sum, uint32_t *n, double *best)
+static void tally(gs_real x, gs_real *sum, uint32_t *n, gs_real *best)
 {
-    if (!gs_dfinite(x)) return;
+    if (!isfinite(x)) return;
     *sum += x;
     ++*n;
-    if (best && !gs_dle(x, *best)) *best = x; /* NaN best: the first */
+    if (best && !(x <= *best)) *best = x; /* NaN best: the first */
 }
 
 void gs_session_jump(gs_session *s, const gs_ev_jump *j)
@@ -117,10 +126,11 @@ void gs_session_event(const gs_session *s, bool ended, const char *reason, const
     e->session = s->id;
     e->ended = ended;
     e->reason = ended ? reason : NULL;
-    e->t_start_s = s->t_start_s;
-    e->t_end_s = ended ? s->t_seen_s : NAN;
-    e->stature_m = e->ci95_lo_m = e->ci95_hi_m = NAN;
-    e->best_jump_m = e->mean_jump_m = e->best_flight_s = e->mean_flight_s = e->mean_takeoff_velocity_m_s = NAN;
+    e->t_start_us = s->t_start_us;
+    e->t_end_us = ended ? s->t_seen_us : GS_T_NONE;
+    e->stature_m = e->ci95_lo_m = e->ci95_hi_m = (gs_real)NAN;
+    e->best_jump_m = e->mean_jump_m = e->best_flight_s = e->mean_flight_s = e->mean_takeoff_velocity_m_s =
+        (gs_real)NAN;
     e->n_jumps = s->n_jumps;
     e->n_rejected = s->n_rejected;
     if (!ended) return;
@@ -131,9 +141,9 @@ void gs_session_event(const gs_session *s, bool ended, const char *reason, const
     }
     e->best_jump_m = s->best_jump_m;
     e->best_flight_s = s->best_flight_s;
-    if (s->n_jump_h) e->mean_jump_m = s->sum_jump_m / (double)s->n_jump_h;
-    if (s->n_flight_t) e->mean_flight_s = s->sum_flight_s / (double)s->n_flight_t;
-    if (s->n_v) e->mean_takeoff_velocity_m_s = s->sum_v_m_s / (double)s->n_v;
+    if (s->n_jump_h) e->mean_jump_m = s->sum_jump_m / (gs_real)s->n_jump_h;
+    if (s->n_flight_t) e->mean_flight_s = s->sum_flight_s / (gs_real)s->n_flight_t;
+    if (s->n_v) e->mean_takeoff_velocity_m_s = s->sum_v_m_s / (gs_real)s->n_v;
 }
 
 void gs_session_close(gs_session *s)

@@ -18,9 +18,10 @@ namespace gs {
 
 Capture::~Capture() = default;
 
-void Capture::deliver(CaptureFrame &f, double t_s, int64_t seq)
+void Capture::deliver(CaptureFrame &f, double t_s, int64_t seq, int64_t t_us)
 {
     f.t_s = t_s;
+    f.t_us = t_us;
     f.sequence = seq;
     f.index = frames_++;
     drops_.frame(t_s, seq);

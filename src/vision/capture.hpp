@@ -20,6 +20,8 @@ namespace gs {
 struct CaptureFrame {
     cv::Mat bgr;            // 8-bit BGR (owned: valid after the next read)
     double t_s = 0.0;       // the source's timestamp, seconds
+    int64_t t_us = INT64_MIN;  // the same in whole microseconds where the source counts in
+                               // integers (V4L2, libcamera), INT64_MIN (GS_T_NONE) otherwise
     int64_t index = 0;      // 0-based count of delivered frames
     int64_t sequence = -1;  // driver sequence number, -1 when the source has none
 };
@@ -81,8 +83,8 @@ public:
     const DropCounter &drops() const { return drops_; }
 
 protected:
-    // bookkeeping for one delivered frame
-    void deliver(CaptureFrame &f, double t_s, int64_t seq);
+    // bookkeeping for one delivered frame (t_us: the source's integer time, if any)
+    void deliver(CaptureFrame &f, double t_s, int64_t seq, int64_t t_us = INT64_MIN);
     std::string desc_, error_;
     double fps_ = 0.0;
     cv::Size size_;

@@ -252,6 +252,12 @@ ReadResult LibcameraCapture::read(CaptureFrame &f, int timeout_ms)
     bool ok = fb && fb->metadata().status == lc::FrameMetadata::FrameSuccess && decode(fb, f.bgr);
     std::optional<int64_t> ts = r->metadata().get(lc::controls::SensorTimestamp);
     double t = ts ? static_cast<double>(*ts) * 1e-9 : (fb ? static_cast<double>(fb->metadata().timestamp) * 1e-9 : NAN);
+    // nanoseconds (>= 0) to the nearest whole microsecond for the core
+    int64_t t_us = INT64_MIN;
+    if (ts && *ts >= 0)
+        t_us = (*ts + 500) / 1000;
+    else if (!ts && fb)
+        t_us = static_cast<int64_t>((fb->metadata().timestamp + 500u) / 1000u);
     int64_t seq = fb ? static_cast<int64_t>(fb->metadata().sequence) : -1;
     r->reuse(lc::Request::ReuseBuffers);
     cam_->queueRequest(r);
@@ -259,7 +265,7 @@ ReadResult LibcameraCapture::read(CaptureFrame &f, int timeout_ms)
         corrupt_++;
         return ReadResult::timeout;
     }
-    deliver(f, t, seq);
+    deliver(f, t, seq, t_us);
     return ReadResult::frame;
 }
 

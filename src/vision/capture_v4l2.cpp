@@ -298,6 +298,8 @@ ReadResult V4l2Capture::read(CaptureFrame &f, int timeout_ms)
     if (b.index >= bufs_.size()) return fail("the driver returned buffer " + std::to_string(b.index), 0);
     bool ok = !(b.flags & V4L2_BUF_FLAG_ERROR) && decode(bufs_[b.index], b.bytesused, f.bgr);
     const double t = static_cast<double>(b.timestamp.tv_sec) + 1e-6 * static_cast<double>(b.timestamp.tv_usec);
+    // the driver counts whole microseconds: kept exact for the core
+    const int64_t t_us = static_cast<int64_t>(b.timestamp.tv_sec) * 1000000 + static_cast<int64_t>(b.timestamp.tv_usec);
     monotonic_ = (b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
     time_origin_ = monotonic_ ? "driver" : "driver_unknown_clock";
     if (io_->ioctl(fd_, VIDIOC_QBUF, &b) != 0) {
@@ -310,7 +312,7 @@ ReadResult V4l2Capture::read(CaptureFrame &f, int timeout_ms)
         corrupt_++;  // a broken JPEG or a short buffer: skipped, counted
         return ReadResult::timeout;
     }
-    deliver(f, t, static_cast<int64_t>(b.sequence));
+    deliver(f, t, static_cast<int64_t>(b.sequence), t_us);
     return ReadResult::frame;
 }
 

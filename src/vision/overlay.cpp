@@ -93,19 +93,24 @@ void fit_jump_curves(RunRecord &r)
     for (JumpRecord &j : r.jumps) {
         j.has_curve = false;
         if (!(std::isfinite(j.t_takeoff_s) && std::isfinite(j.t_land_s) && j.t_land_s > j.t_takeoff_s)) continue;
+        // the fit counts in microseconds: centre and length of the window
+        const int64_t t0_us = gs_time_us_of_s(0.5 * (j.t_takeoff_s + j.t_land_s));
+        const int64_t tscale_us = gs_time_us_of_s(j.t_land_s - j.t_takeoff_s);
+        if (t0_us == GS_T_NONE || tscale_us == GS_T_NONE || tscale_us <= 0) continue;
         gs_fit f;
-        gs_fit_init(&f, 0.5 * (j.t_takeoff_s + j.t_land_s), j.t_land_s - j.t_takeoff_s);
+        gs_fit_init(&f, t0_us, tscale_us);
         for (size_t i = 0; i < r.frame_t.size(); i++) {
             double t = r.frame_t[i];
             if (t < j.t_takeoff_s || t > j.t_land_s) continue;
+            const int64_t t_us = gs_time_us_of_s(t);
             for (const ObsRecord &o : r.frame_obs[i])
                 if (o.track == static_cast<int>(j.track))
-                    gs_fit_add(&f, t, o.x_px, o.y_px, std::max(o.confidence, 1e-3));
+                    gs_fit_add(&f, t_us, o.x_px, o.y_px, std::max(o.confidence, 1e-3));
         }
         gs_fit_result fr;
         if (gs_fit_solve(&f, &fr) != GS_OK) continue;
         j.has_curve = true;
-        j.t0_s = fr.t0_s;
+        j.t0_s = gs_time_s_of_us(fr.t0_us);
         j.x0 = fr.x0_px;
         j.vx = fr.vx_px_s;
         j.ax = fr.ax_px_s2;

@@ -1,5 +1,5 @@
 /* fuzz_emit.c - libFuzzer harness for the core's emitter (src/core/gs_emit.c):
- * random events, any double bit pattern, any counts, any caller strings, into
+ * random events, any value bit pattern (gs_real), any int64 time (GS_T_NONE too), any counts, any caller strings, into
  * exact-size heap buffers of every interesting capacity. Properties: never a
  * byte past cap; all or nothing (0 and "" when it does not fit, else the same
  * line at every larger cap); JSON Lines always one valid JSON object in valid
@@ -40,6 +40,16 @@ static const char *str_ok(const char *s, bool *short_strings)
     return s;
 }
 
+/* any int64 microseconds: GS_T_NONE, the limits and beyond them, and everything between */
+static int64_t fz_time(fz_in *in)
+{
+    static const int64_t edge[] = {GS_T_NONE, INT64_MIN + 1, INT64_MAX, GS_T_MAX_US, -GS_T_MAX_US, 0, -1, -500, 500};
+    uint8_t sel = fz_u8(in);
+    if (sel < sizeof edge / sizeof edge[0]) return edge[sel];
+    uint64_t hi = fz_u32(in), lo = fz_u32(in);
+    return (int64_t)(hi << 32 | lo);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = {data, size};
@@ -57,7 +67,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         gs_ev_start *s = &ev.u.start;
         s->version = STR(0);
         s->config = STR(1);
-        s->fps_source = fz_double(&in);
+        s->fps_source = (gs_real)fz_double(&in);
         s->fps_origin = STR(2);
         s->layout = STR(3);
         break;
@@ -66,10 +76,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         gs_ev_jump *j = &ev.u.jump;
         j->track = fz_u32(&in);
         j->index = fz_u32(&in);
-        double *d[] = {&j->t_takeoff_s, &j->t_land_s, &j->flight_time_s, &j->t_apex_s, &j->a_px_s2,
-                       &j->a_px_se_s2, &j->g_dir_deg, &j->q_m_per_px, &j->size_px, &j->height_m,
-                       &j->height_se_m, &j->jump_height_m, &j->takeoff_velocity_m_s, &j->rms_px};
-        for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) *d[i] = fz_double(&in);
+        j->t_takeoff_us = fz_time(&in);
+        j->t_land_us = fz_time(&in);
+        j->t_apex_us = fz_time(&in);
+        gs_real *d[] = {&j->flight_time_s, &j->a_px_s2, &j->a_px_se_s2, &j->g_dir_deg, &j->q_m_per_px,
+                        &j->size_px, &j->height_m, &j->height_se_m, &j->jump_height_m, &j->takeoff_velocity_m_s,
+                        &j->rms_px};
+        for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) *d[i] = (gs_real)fz_double(&in);
         j->n_samples = fz_u32(&in);
         j->n_outliers = fz_u32(&in);
         j->accepted = fz_u8(&in) & 1u;
@@ -81,9 +94,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case GS_EV_SUMMARY: {
         gs_ev_height *h = &ev.u.height;
         h->track = fz_u32(&in);
-        h->height_m = fz_double(&in);
-        h->ci95_lo_m = fz_double(&in);
-        h->ci95_hi_m = fz_double(&in);
+        h->height_m = (gs_real)fz_double(&in);
+        h->ci95_lo_m = (gs_real)fz_double(&in);
+        h->ci95_hi_m = (gs_real)fz_double(&in);
         h->n_jumps = fz_u32(&in);
         h->n_rejected = fz_u32(&in);
         break;
@@ -94,27 +107,28 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         e->session = fz_u32(&in);
         e->ended = fz_u8(&in) & 1u;
         e->reason = STR(4);
-        double *d[] = {&e->t_start_s, &e->t_end_s, &e->stature_m, &e->ci95_lo_m, &e->ci95_hi_m,
-                       &e->best_jump_m, &e->mean_jump_m, &e->best_flight_s, &e->mean_flight_s,
-                       &e->mean_takeoff_velocity_m_s};
-        for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) *d[i] = fz_double(&in);
+        e->t_start_us = fz_time(&in);
+        e->t_end_us = fz_time(&in);
+        gs_real *d[] = {&e->stature_m, &e->ci95_lo_m, &e->ci95_hi_m, &e->best_jump_m, &e->mean_jump_m,
+                        &e->best_flight_s, &e->mean_flight_s, &e->mean_takeoff_velocity_m_s};
+        for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) *d[i] = (gs_real)fz_double(&in);
         e->n_jumps = fz_u32(&in);
         e->n_rejected = fz_u32(&in);
         break;
     }
     case GS_EV_WARNING:
         ev.u.warning.track = fz_u32(&in);
-        ev.u.warning.t_s = fz_double(&in);
+        ev.u.warning.t_us = fz_time(&in);
         ev.u.warning.warnings = fz_u32(&in);
         break;
     case GS_EV_STATE:
-        ev.u.state.t_s = fz_double(&in);
+        ev.u.state.t_us = fz_time(&in);
         ev.u.state.from = STR(5);
         ev.u.state.to = STR(6);
         break;
     case GS_EV_SAMPLE: {
         gs_ev_sample *s = &ev.u.sample;
-        s->t_s = fz_double(&in);
+        s->t_us = fz_time(&in);
         s->x_px = (float)fz_double(&in);
         s->y_px = (float)fz_double(&in);
         s->w = (float)fz_double(&in);
@@ -124,12 +138,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     case GS_EV_FIT: {
         gs_ev_fit *f = &ev.u.fit;
-        f->t_first_s = fz_double(&in);
-        f->t_last_s = fz_double(&in);
+        f->t_first_us = fz_time(&in);
+        f->t_last_us = fz_time(&in);
         f->n = fz_u32(&in);
-        f->a_px_s2 = fz_double(&in);
-        f->g_dir_deg = fz_double(&in);
-        f->rms_px = fz_double(&in);
+        f->a_px_s2 = (gs_real)fz_double(&in);
+        f->g_dir_deg = (gs_real)fz_double(&in);
+        f->rms_px = (gs_real)fz_double(&in);
         f->purpose = STR(7);
         break;
     }

@@ -41,13 +41,27 @@ static gs_status core_key(void *ctx, const char *key, size_t key_len, const char
     return st;
 }
 
-/* a C literal that reads back as exactly v (hex float; NAN for unknown) */
-static void put_real(FILE *f, const char *field, double v, const char *suffix)
+/* a C literal that reads back as exactly v (hex float; NAN for unknown); cast: a
+ * prefix such as "(gs_real)" (the field's type in the firmware's build, which may
+ * differ from this program's), suffix: "f" for a float field */
+static void put_real(FILE *f, const char *field, double v, const char *cast, const char *suffix)
 {
     if (isnan(v))
-        fprintf(f, "    .%s = NAN, \\\n", field);
+        fprintf(f, "    .%s = %sNAN, \\\n", field, cast);
     else
-        fprintf(f, "    .%s = %a%s, \\\n", field, v, suffix);
+        fprintf(f, "    .%s = %s%a%s, \\\n", field, cast, v, suffix);
+}
+
+/* a gs_real field: this program's value, converted to the firmware's gs_real by its
+ * compiler (where that is float: the same rounding as its parser's (float) of the double) */
+static void put_gs_real(FILE *f, const char *field, gs_real v)
+{
+    put_real(f, field, (double)v, "(gs_real)", "");
+}
+
+static void put_float(FILE *f, const char *field, float v)
+{
+    put_real(f, field, (double)v, "", "f");
 }
 
 static void put_text(FILE *f, const char *s, size_t n)
@@ -76,25 +90,25 @@ static int write_header(FILE *f, const char *path, const gs_core_config *c, cons
     put_text(f, cc->text, cc->len);
     fputs("\n/* the same section parsed and checked at build time (every field of gs_core_config) */\n", f);
     fputs("#define FW_PROFILE_CONFIG { \\\n", f);
-    put_real(f, "g_m_s2", c->g_m_s2, "");
-    put_real(f, "latitude_deg", c->latitude_deg, "");
-    put_real(f, "altitude_m", c->altitude_m, "");
+    put_gs_real(f, "g_m_s2", c->g_m_s2);
+    put_gs_real(f, "latitude_deg", c->latitude_deg);
+    put_gs_real(f, "altitude_m", c->altitude_m);
     fprintf(f, "    .mass_table = (gs_mass_table)%d, \\\n", (int)c->mass_table);
     fprintf(f, "    .stature = (gs_stature_method)%d, \\\n", (int)c->stature);
-    put_real(f, "min_conf", c->min_conf, "f");
+    put_float(f, "min_conf", c->min_conf);
     fprintf(f, "    .fit_method = (gs_fit_method)%d, \\\n", (int)c->fit_method);
     fprintf(f, "    .ring_capacity = %uu, \\\n", (unsigned)c->ring_capacity);
-    put_real(f, "min_flight_s", c->min_flight_s, "f");
-    put_real(f, "max_flight_s", c->max_flight_s, "f");
+    put_float(f, "min_flight_s", c->min_flight_s);
+    put_float(f, "max_flight_s", c->max_flight_s);
     fprintf(f, "    .min_samples = %uu, \\\n", (unsigned)c->min_samples);
-    put_real(f, "max_rms_rel", c->max_rms_rel, "f");
-    put_real(f, "max_a_se_rel", c->max_a_se_rel, "f");
-    put_real(f, "size_min_m", c->size_min_m, "f");
-    put_real(f, "size_max_m", c->size_max_m, "f");
-    put_real(f, "max_gap_s", c->max_gap_s, "f");
-    put_real(f, "landing_latency_s", c->landing_latency_s, "f");
-    put_real(f, "session_absence_s", c->session_absence_s, "f");
-    put_real(f, "session_new_body_rel", c->session_new_body_rel, "f");
+    put_float(f, "max_rms_rel", c->max_rms_rel);
+    put_float(f, "max_a_se_rel", c->max_a_se_rel);
+    put_float(f, "size_min_m", c->size_min_m);
+    put_float(f, "size_max_m", c->size_max_m);
+    put_float(f, "max_gap_s", c->max_gap_s);
+    put_float(f, "landing_latency_s", c->landing_latency_s);
+    put_float(f, "session_absence_s", c->session_absence_s);
+    put_float(f, "session_new_body_rel", c->session_new_body_rel);
     fprintf(f, "    .format = (gs_format)%d, \\\n", (int)c->format);
     fputs("}\n\n#endif\n", f);
     return ferror(f) ? -1 : 0;

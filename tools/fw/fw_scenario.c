@@ -12,7 +12,8 @@
 #include "gravscale/gravscale.h"
 
 #define FW_RING_CAP 512u
-#define FW_FPS 60.0
+#define FW_FPS 60u
+#define FW_T0_US INT64_C(1000000000)  /* a boot clock far from zero, so times are not small numbers */
 
 /* ring + inlier bits, as gs_pipeline_storage_bytes computes for FW_RING_CAP */
 #define FW_STORAGE_BYTES (FW_RING_CAP * sizeof(gs_sample) + (FW_RING_CAP + 31u) / 32u * 4u)
@@ -47,7 +48,7 @@ static float bounce_m(float t)
 /* the skeleton's layout: COCO-17 when built in (gs_features.h), else BlazePose-33 */
 #define FW_POSE_LAYOUT (GS_WITH_COCO17 ? GS_LAYOUT_COCO17 : GS_LAYOUT_BLAZEPOSE33)
 
-static void push_pose(double t, float y_off_px)
+static void push_pose(int64_t t_us, float y_off_px)
 {
     /* a standing skeleton about 530 px tall, lifted by y_off_px (COCO-17 order) */
     static const float k_y[17] = {60, 52, 52, 56, 56, 110, 110, 190, 190, 260, 260, 290, 290, 400, 400, 530, 530};
@@ -74,7 +75,7 @@ static void push_pose(double t, float y_off_px)
         }
     }
 #endif
-    g_status |= (uint32_t)gs_pipeline_push_keypoints(&g_pipe, t, kp);
+    g_status |= (uint32_t)gs_pipeline_push_keypoints_us(&g_pipe, t_us, kp);
 }
 #endif
 
@@ -101,16 +102,17 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, layout,
                                            g_storage, sizeof g_storage, on_event, NULL);
     const float q_m_per_px = 0.002f;
-    for (uint32_t i = 0; i < 6u * (uint32_t)FW_FPS; i++) {
-        /* a boot clock far from zero, so times are not small numbers */
-        double t = 1000.0 + (double)i / FW_FPS;
+    for (uint32_t i = 0; i < 6u * FW_FPS; i++) {
+        /* frame i at i / FW_FPS s, rounded to the microsecond (32-bit: no 64-bit division) */
+        int64_t t_us = FW_T0_US + (int64_t)((i * 1000000u + FW_FPS / 2u) / FW_FPS);
         float h = bounce_m((float)i / (float)FW_FPS);
         if (pose) {
 #if GS_WITH_POSE
-            push_pose(t, h / q_m_per_px);
+            push_pose(t_us, h / q_m_per_px);
 #endif
         } else {
-            g_status |= (uint32_t)gs_pipeline_push_point(&g_pipe, t, 320.0f, 400.0f - h / q_m_per_px, 1.0f, 34.35f);
+            g_status |= (uint32_t)gs_pipeline_push_point_us(&g_pipe, t_us, 320.0f, 400.0f - h / q_m_per_px, 1.0f,
+                                                            34.35f);
         }
     }
     g_status |= (uint32_t)gs_pipeline_flush(&g_pipe);
