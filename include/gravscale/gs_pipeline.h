@@ -28,8 +28,6 @@ typedef struct {
     void *ctx;
     gs_jump_judge_fn judge;    /* NULL: none */
     void *judge_ctx;
-    int64_t last_t_us;         /* GS_T_NONE before the first frame */
-    uint64_t n_frames;
     bool finished;
 } gs_pipeline;
 

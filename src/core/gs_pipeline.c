@@ -69,7 +69,6 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     p->layout = layout;
     p->on_event = on_event;
     p->ctx = ctx;
-    p->last_t_us = GS_T_NONE;
     uint32_t cap = cfg->ring_capacity;
     gs_sample *samples = (gs_sample *)storage;
     uint32_t *scratch = (uint32_t *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
@@ -131,20 +130,19 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
 {
     if (p->finished) return GS_ESTATE;
     if (s->t_us == GS_T_NONE) return GS_EINVAL;
-    if (p->last_t_us != GS_T_NONE) {
-        if (s->t_us < p->last_t_us) return GS_EORDER;
-        if (s->t_us == p->last_t_us) return GS_OK;  /* a repeated frame carries nothing new */
+    const int64_t last_us = p->ring.t_last_us;  /* the newest frame's, GS_T_NONE before the first */
+    if (last_us != GS_T_NONE) {
+        if (s->t_us < last_us) return GS_EORDER;
+        if (s->t_us == last_us) return GS_OK;  /* a repeated frame carries nothing new */
     }
     if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
      * left open must close on them first (as it would on any long gap); the
      * difference as uint64 is exact for any two accepted times */
-    if (p->last_t_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)p->last_t_us >= (uint64_t)GS_RING_SPAN_US)
+    if (last_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
         gs_flight_break(&p->flight);
     gs_status st = gs_ring_push(&p->ring, s);
     if (st != GS_OK) return st;
-    p->last_t_us = s->t_us;
-    p->n_frames++;
     if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
