@@ -41,9 +41,9 @@ case ${GS_FW_DEVICE:-all} in
   all) ;;
   ball-lab) dev_features="GS_WITH_JSON=0 GS_WITH_COCO17=0 GS_WITH_BLAZEPOSE33=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
             dev_profile=OFF ;;
-  camera-coco17) dev_features="GS_WITH_JSON=0 GS_WITH_BLAZEPOSE33=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
+  camera-coco17) dev_features="GS_WITH_JSON=0 GS_WITH_POINT=0 GS_WITH_BLAZEPOSE33=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
                  dev_profile=OFF ;;
-  camera-blazepose33) dev_features="GS_WITH_JSON=0 GS_WITH_COCO17=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
+  camera-blazepose33) dev_features="GS_WITH_JSON=0 GS_WITH_POINT=0 GS_WITH_COCO17=0 GS_WITH_TRACE=0 GS_WITH_RANSAC=0"
                       dev_profile=OFF ;;
   *) echo "firmware_size: unknown GS_FW_DEVICE '$GS_FW_DEVICE' (all, ball-lab, camera-coco17, camera-blazepose33)" >&2; exit 2 ;;
 esac

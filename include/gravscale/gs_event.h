@@ -26,7 +26,10 @@ typedef enum {
     GS_REJ_NO_SIZE,         /* "no_size": no standing pixel size known around the flight */
     GS_REJ_UNCERTAIN_A,     /* "uncertain_acceleration": relative SE of a too large */
     GS_REJ_GAP,             /* "gap": frames missing inside the flight */
-    GS_REJ_OTHER_MOTION     /* "other_motion": from the front end: something else moved beside the body through much of the flight */
+    GS_REJ_OTHER_MOTION,    /* "other_motion": from the front end: something else moved beside the body through much of the flight */
+    GS_REJ_GRAVITY_DIR,     /* "gravity_direction": the fitted gravity disagrees with the standing body's axis or earlier flights beyond its standard error */
+    GS_REJ_FALL,            /* "fall": landed on a floor lower than it left (a step off a box): a free fall, not a jump */
+    GS_REJ_NO_FEET_FLIGHT   /* "no_feet_flight": the feet, seen throughout, did not leave the floor together and land around the COM's flight */
 } gs_reject_reason;
 
 /* warning bits of a jump */
@@ -40,6 +43,11 @@ typedef enum {
 #define GS_WARN_LEFT_FRAME    0x40u /* "left_frame": the body touched the frame's border during the flight */
 #define GS_WARN_OUT_OF_PLANE  0x80u /* "out_of_plane": the body moved toward or away from the camera */
 #define GS_WARN_OTHER_MOTION  0x100u /* "other_motion": something else moved right beside the body during the flight */
+/* set by the core (body layouts) */
+#define GS_WARN_NO_SIZE       0x200u /* "no_size": no standing size known: the flight is measured, its height unknown */
+#define GS_WARN_DEPTH_CHANGED 0x400u /* "depth_changed": the body stood elsewhere (its feet on another floor row): height left out */
+#define GS_WARN_COM_TIMED     0x800u /* "com_timed": the feet were not seen leaving or meeting the floor: times from the COM alone */
+#define GS_WARN_COM_MISMATCH  0x1000u /* "com_mismatch": the COM at landing sits far from its height at take-off (posture or timing) */
 
 const char *gs_reject_reason_name(gs_reject_reason r);
 
@@ -59,7 +67,11 @@ typedef struct {
     gs_real a_px_s2, a_px_se_s2, g_dir_deg, q_m_per_px;
     gs_real size_px;          /* pixel size used (standing stature, ball diameter) */
     gs_real height_m, height_se_m;
-    gs_real jump_height_m, takeoff_velocity_m_s;
+    gs_real jump_height_m;    /* g T^2 / 8 from the flight time (contact mats, apps) */
+    gs_real takeoff_velocity_m_s;  /* the COM's vertical speed at take-off, g (t_apex - t_takeoff) */
+    gs_real com_rise_m;       /* the COM's rise from take-off to the apex, v0^2 / 2g (force plates) */
+    gs_real contact_time_s;   /* ground contact before this take-off since the last landing (drop and repeated jumps), NaN none */
+    gs_real rsi;              /* reactive strength index: jump_height_m / contact_time_s, NaN none */
     uint32_t n_samples, n_outliers;
     gs_real rms_px;
     bool accepted;

@@ -16,7 +16,11 @@
 #ifndef GS_WITH_NMEA
 #define GS_WITH_NMEA 1
 #endif
-/* keypoint layouts (gs_com.h); the single point (a ball) is always in */
+/* keypoint layouts (gs_com.h): one tracked point (a ball), with its flights' sub-frame
+ * boundaries from the COM's contact model (a body's come from its feet) */
+#ifndef GS_WITH_POINT
+#define GS_WITH_POINT 1
+#endif
 #ifndef GS_WITH_COCO17
 #define GS_WITH_COCO17 1
 #endif
@@ -35,6 +39,9 @@
 /* a skeleton layout: the COM model, the standing tracker, visits (sessions) */
 #define GS_WITH_POSE (GS_WITH_COCO17 || GS_WITH_BLAZEPOSE33)
 
+#if !GS_WITH_POINT && !GS_WITH_POSE
+#error "gs_features.h: at least one layout (GS_WITH_POINT, GS_WITH_COCO17, GS_WITH_BLAZEPOSE33)"
+#endif
 #if !GS_WITH_JSON && !GS_WITH_NMEA
 #error "gs_features.h: at least one output format (GS_WITH_JSON, GS_WITH_NMEA)"
 #endif

@@ -9,6 +9,7 @@
 #include "gs_fit.h"
 #include "gs_config.h"
 #include "gs_event.h"
+#include "gs_feet.h"
 
 typedef enum {
     GS_FS_IDLE = 0,   /* no reliable samples yet / lost */
@@ -78,10 +79,24 @@ typedef struct {
     gs_real last_a_px_s2;      /* last accepted acceleration, NaN none */
     gs_real last_g_dir_deg;
     uint32_t n_flights;
+
+    /* the feet (body layouts): take-off and landing times, the floor, drop jumps */
+    bool feet_on;              /* the layout shows feet (gs_flight_use_feet) */
+    gs_feet feet;
+    float stand_floor_px;      /* the feet's floor level while the kept standing sizes were taken, NaN unknown */
+    uint16_t stand_floor_epoch;/* ... measured in this epoch of the feet's direction */
+    int64_t last_land_us;      /* the latest landing (of a jump or a fall), GS_T_NONE none */
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx);
+/* Time flights by the feet: two foot points per frame (gs_flight_feet), lifting delta_rel
+ * x stature above their rest when the foot leaves; stop_touch: see gs_feet.h. */
+void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch);
+/* The frame at t_us's two foot points (NaN missing) and the body's size this frame (NaN
+ * unknown), before the frame's sample is examined (gs_flight_update). */
+void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
+                    const float y_px[GS_FEET_POINTS], float size_px);
 /* Examine every sample pushed to the ring since the last call. Emits GS_EV_JUMP
  * events through on_event (and trace events when f->trace). */
 void gs_flight_update(gs_flight *f);

@@ -540,7 +540,7 @@ size_t gs_layout_kp_count(gs_layout layout)
 {
     switch (layout) {
     /* a layout left out of the build (gs_features.h) is unknown */
-    case GS_LAYOUT_POINT: return 1;
+    case GS_LAYOUT_POINT: return GS_WITH_POINT ? 1u : 0u;
     case GS_LAYOUT_COCO17: return GS_WITH_COCO17 ? 17u : 0u;
     case GS_LAYOUT_BLAZEPOSE33: return GS_WITH_BLAZEPOSE33 ? 33u : 0u;
     default: return 0;

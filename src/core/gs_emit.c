@@ -354,7 +354,8 @@ static void w_jstr(gs_w *w, const char *s)
 /* names of the GS_WARN_* bits, in bit order (protocol names) */
 static const char *const k_warn_names[] = {"few_samples", "gravity_tilt", "size_changed", "outliers",
                                            "edge_truncated", "camera_moved", "left_frame", "out_of_plane",
-                                           "other_motion"};
+                                           "other_motion", "no_size", "depth_changed", "com_timed",
+                                           "com_mismatch"};
 
 /* [names of the known set bits, in bit order] */
 static void w_warnings(gs_w *w, uint32_t bits)
@@ -470,19 +471,22 @@ static const json_field k_json_fields[] = {
     JF(gs_ev_jump, height_se_m, V_FIXED, 4),
     JF(gs_ev_jump, jump_height_m, V_FIXED, 4),
     JF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 3),
+    JF(gs_ev_jump, com_rise_m, V_FIXED, 4),
+    JF(gs_ev_jump, contact_time_s, V_FIXED, 4),
+    JF(gs_ev_jump, rsi, V_FIXED, 3),
     JF(gs_ev_jump, n_samples, V_U32, 0),
     JF(gs_ev_jump, n_outliers, V_U32, 0),
     JF(gs_ev_jump, rms_px, V_FIXED, 3),
     JF(gs_ev_jump, accepted, V_BOOL, 0),
     JF(gs_ev_jump, reason, V_REASON, 0),
     JF(gs_ev_jump, warnings, V_WARNINGS, 0),
-#define J_HEIGHT 26
+#define J_HEIGHT 29
     JF(gs_ev_height, track, V_U32, 0),
     JF(gs_ev_height, height_m, V_FIXED, 4),
     JFX(gs_ev_height, "ci95_m", height_m, V_CI95, 0),
     JF(gs_ev_height, n_jumps, V_U32, 0),
     JF(gs_ev_height, n_rejected, V_U32, 0),
-#define J_SESSION 31
+#define J_SESSION 34
     JF(gs_ev_session, track, V_U32, 0),
     JF(gs_ev_session, session, V_U32, 0),
     JFX(gs_ev_session, "state", ended, V_BOOL, 1),
@@ -498,24 +502,24 @@ static const json_field k_json_fields[] = {
     JF(gs_ev_session, best_flight_s, V_FIXED, 4),
     JF(gs_ev_session, mean_flight_s, V_FIXED, 4),
     JF(gs_ev_session, mean_takeoff_velocity_m_s, V_FIXED, 3),
-#define J_WARNING 46
+#define J_WARNING 49
     JF(gs_ev_warning, track, V_U32, 0),
     JFX(gs_ev_warning, "t_s", t_us, V_TIME, 4),
     JF(gs_ev_warning, warnings, V_WARNINGS, 0),
-#define J_TRACE 49
+#define J_TRACE 52
 #if GS_WITH_TRACE /* trace events (gs_features.h): without them, no form (returns 0) */
 #define J_STATE J_TRACE
     JFX(gs_ev_state, "t_s", t_us, V_TIME, 4),
     JF(gs_ev_state, from, V_STR, 0),
     JF(gs_ev_state, to, V_STR, 0),
-#define J_SAMPLE 52
+#define J_SAMPLE 55
     JFX(gs_ev_sample, "t_s", t_us, V_TIME, 4),
     JF(gs_ev_sample, x_px, V_FLOAT, 2),
     JF(gs_ev_sample, y_px, V_FLOAT, 2),
     JF(gs_ev_sample, w, V_FLOAT, 3),
     JF(gs_ev_sample, size_px, V_FLOAT, 2),
     JF(gs_ev_sample, upright, V_FLOAT, 3),
-#define J_FIT 58
+#define J_FIT 61
     JF(gs_ev_fit, purpose, V_STR, 0),
     JFX(gs_ev_fit, "t_first_s", t_first_us, V_TIME, 4),
     JFX(gs_ev_fit, "t_last_s", t_last_us, V_TIME, 4),
@@ -523,7 +527,7 @@ static const json_field k_json_fields[] = {
     JF(gs_ev_fit, a_px_s2, V_SIG, 6),
     JF(gs_ev_fit, g_dir_deg, V_FIXED, 2),
     JF(gs_ev_fit, rms_px, V_FIXED, 3),
-#define J_END 65
+#define J_END 68
 #else
 #define J_END J_TRACE
 #endif

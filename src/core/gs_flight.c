@@ -70,6 +70,15 @@
 #define DT_DEFAULT_Q4    533333u      /* 1/30 s in 1/16 us: the frame interval before one is seen */
 #define DT_MAX_US        (INT64_C(1) << 26)  /* longer frame intervals count as this (67 s) */
 #define EMIT_FACTOR      GS_R(2.0)    /* candidates implying a size beyond [min/2, max*2] are not flights */
+/* the feet (body layouts) */
+#define FEET_BEFORE_COM_US 150000     /* the feet's take-off and landing lie after the COM's boundary minus this */
+#define FEET_AFTER_COM_US  100000     /* ... and the landing before the COM's plus this (the COM keeps falling a frame or two) */
+#define CONTACT_MAX_US   1000000      /* a rebound leaves the ground within this of the landing (drop jumps: 0.2-0.9 s) */
+#define DEPTH_TOL_REL    GS_R(0.015)  /* standing at the flight's place: its floor row within this x size */
+#define FALL_REL         0.05f        /* landed this x size below the floor it left: a fall from a box, not a jump */
+#define COM_MISMATCH_REL GS_R(0.04)   /* the COM at landing this x size off its take-off height: flagged */
+#define GRAV_DIR_SE_K    GS_R(2.0)    /* gravity's direction may differ from the expected by this many SE ... */
+#define GRAV_DIR_MIN_DEG GS_R(8.0)    /* ... plus this (a standing body's axis leans a few degrees, most seen from the side) */
 
 /* isfinite of a gs_real (or float) value, in one place */
 static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
@@ -202,6 +211,7 @@ static gs_real med3(gs_real a, gs_real b, gs_real c)
 }
 
 static void restart_levels(gs_flight *f, uint64_t i);
+static float last_stand_size(const gs_flight *f);
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
@@ -231,7 +241,26 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
+    f->feet_on = false;
+    gs_feet_init(&f->feet, 0.0f, true);
+    f->last_land_us = GS_T_NONE;
     return GS_OK;
+}
+
+void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch)
+{
+    if (!f) return;
+    f->feet_on = true;
+    gs_feet_init(&f->feet, delta_rel, stop_touch);
+}
+
+void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
+                    const float y_px[GS_FEET_POINTS], float size_px)
+{
+    if (!f || !f->feet_on) return;
+    /* the standing size scales the thresholds; before one is known, the frame's own */
+    gs_real size = f->stand_n > 0 ? (gs_real)last_stand_size(f) : (gs_real)size_px;
+    gs_feet_push(&f->feet, t_us, x_px, y_px, f->up_x, f->up_y, size);
 }
 
 /* ---- per-flight helpers ---------------------------------------------------- */
@@ -342,9 +371,10 @@ static void track_frame_dt(gs_flight *f, int64_t dt_us)
 }
 
 static gs_real stand_size(const gs_flight *f, gs_real *se_out);
+static float last_stand_size(const gs_flight *f);
 /* a rigid object (the point layout): always, where no skeleton layout is built in
  * (gs_features.h), so the standing tracker is left out of such builds */
-#define IS_RIGID(f) (!GS_WITH_POSE || (f)->rigid)
+#define IS_RIGID(f) (!GS_WITH_POSE || (GS_WITH_POINT && (f)->rigid))
 
 /* Could this fit be free fall? Acceleration roughly along the expected gravity
  * direction, and of a size that makes the object's size plausible (loosely:
@@ -384,6 +414,34 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
     }
     gs_real se;
     return stand_size(f, &se);
+}
+
+/* the fit's apex: where its velocity along its own gravity is zero (GS_T_NONE unknown) */
+static int64_t fit_apex_us(const gs_fit_result *r)
+{
+    gs_real gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
+    gs_real v_down = r->vx_px_s * gx + r->vy_px_s * gy;
+    return gs_time_add_s(r->t0_us, -v_down / r->a_px_s2);
+}
+
+/* the fit's height at t along its own up (against its acceleration), px */
+static gs_real fit_u_at(const gs_fit_result *r, int64_t t_us)
+{
+    gs_real dt = gs_time_span_s(t_us, r->t0_us);
+    gs_real x = r->x0_px + r->vx_px_s * dt + GS_R(0.5) * r->ax_px_s2 * dt * dt;
+    gs_real y = r->y0_px + r->vy_px_s * dt + GS_R(0.5) * r->ay_px_s2 * dt * dt;
+    return -(x * r->ax_px_s2 + y * r->ay_px_s2) / r->a_px_s2;
+}
+
+/* Gravity is one per camera: the fitted direction must agree with the one known (the
+ * standing body's axis, earlier flights) within its standard error; true when none is known. */
+static bool gravity_agrees(const gs_flight *f, const gs_fit_result *r)
+{
+    if (!f->up_from_flight && f->up_n == 0) return true;
+    gs_real cosang = -(r->ax_px_s2 * f->up_x + r->ay_px_s2 * f->up_y) / r->a_px_s2;
+    gs_real lim = GRAV_DIR_SE_K * r->a_se_px_s2 / r->a_px_s2 + GRAV_DIR_MIN_DEG * GS_PI / GS_R(180.0);
+    if (!(lim < GS_R(1.5))) return !(lim == lim) ? false : true;  /* SE unknown: no; SE huge: no test */
+    return cosang >= (gs_real)GS_COS(lim);
 }
 
 /* sample s into the running fit */
@@ -737,8 +795,8 @@ static int64_t boundary_time(const gs_flight *f, const gs_fit_result *r, int sid
 {
     uint64_t first = edge;  /* the first contact sample */
     *outer = edge;
-    uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
     if (!refine) return GS_T_NONE;
+    uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n >= 2)
@@ -813,7 +871,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
-    bool refine = held(f, L);
+    bool refine = IS_RIGID(f) && held(f, L);  /* a body's boundaries are its feet's */
     gs_real sig = fit_sigma(f, &r);
     gs_real pen = DROP_PENALTY * sig * sig;
     uint64_t lo, hi;  /* the outermost contact samples */
@@ -822,7 +880,29 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         (long long)T0, (long long)T1, r.a_px_s2);
-    /* flight samples: strictly inside (T0, T1) */
+    /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
+    float floor_off = NAN, floor_on = NAN, floor_before = NAN;
+    int64_t F0 = GS_T_NONE, F1 = GS_T_NONE;
+    bool feet_contradict = false;  /* the feet, in view, show no flight there */
+    if (f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
+        int64_t apex_us = fit_apex_us(&r);
+        int64_t c0 = T0 != GS_T_NONE ? T0 : t_at(f, L), c1 = T1 != GS_T_NONE ? T1 : t_at(f, R);
+        if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
+
+            F0 = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &floor_off);
+            int64_t from = c1 - FEET_BEFORE_COM_US > apex_us ? c1 - FEET_BEFORE_COM_US : apex_us;
+            F1 = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &floor_on, &floor_before);
+        }
+        DBG("feet: com %lld..%lld apex %lld -> F0 %lld F1 %lld floors %.1f %.1f before %.1f\n", (long long)c0,
+            (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, floor_off, floor_on, floor_before);
+        if (F0 != GS_T_NONE && F1 != GS_T_NONE && F1 <= F0) F0 = F1 = GS_T_NONE;
+        /* feet in view that rest on the floor at the apex, or left it and did not come back
+         * around the COM's landing, say the body was not in flight there (feet that never
+         * rested, as in quick hops, say nothing: the COM times the flight) */
+        if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
+            feet_contradict = gs_feet_resting_at(&f->feet, apex_us) || (F0 != GS_T_NONE && F1 == GS_T_NONE);
+    }
+    /* the fit's samples: strictly inside the COM's (T0, T1), every sample the parabola explains */
     uint64_t in_lo = trim_edge(f, lo, hi, T0, -1, L);
     uint64_t in_hi = trim_edge(f, hi, in_lo, T1, +1, R);
     f->up_x = save_ux;
@@ -859,6 +939,10 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     int64_t half_dt = frame_dt_us(f) / 2;
     if (T0 == GS_T_NONE) T0 = sf->t_us - half_dt;
     if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
+    /* the flight is the feet's time off the floor where they were seen to leave and to land */
+    bool feet = F0 != GS_T_NONE && F1 != GS_T_NONE;
+    if (F0 != GS_T_NONE) T0 = F0;
+    if (F1 != GS_T_NONE) T1 = F1;
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -891,8 +975,24 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         gs_real apex_s = -v_down / fr.a_px_s2;  /* after the fit's t0 */
         j->t_apex_us = gs_time_add_s(fr.t0_us, apex_s);
         gs_real rise_t = gs_time_span_s(fr.t0_us, T0) + apex_s;
-        j->jump_height_m = GS_R(0.5) * g * rise_t * rise_t;
+        j->jump_height_m = g * j->flight_time_s * j->flight_time_s / GS_R(8.0);
+        j->com_rise_m = GS_R(0.5) * g * rise_t * rise_t;
         j->takeoff_velocity_m_s = g * rise_t;
+        /* a rebound: the ground contact since the last landing, no stance between */
+        j->contact_time_s = j->rsi = NAN;
+        if (f->last_land_us != GS_T_NONE && T0 > f->last_land_us && T0 - f->last_land_us <= CONTACT_MAX_US &&
+            !(f->stand_last_us != GS_T_NONE && f->stand_last_us > f->last_land_us)) {
+            j->contact_time_s = gs_time_span_s(T0, f->last_land_us);
+            j->rsi = j->jump_height_m / j->contact_time_s;
+        }
+        if (!IS_RIGID(f) && !feet) j->warnings |= GS_WARN_COM_TIMED;
+        /* the stature only where the body stood at the flight's place (its feet on the same floor row) */
+        if (feet && finite_r(size) && f->feet.epoch == f->stand_floor_epoch && finite_r(f->stand_floor_px) &&
+            finite_r(floor_off) && GS_FABSR((gs_real)(floor_off - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
+            j->warnings |= GS_WARN_DEPTH_CHANGED;
+            size = size_se = NAN;
+            j->size_px = NAN;
+        }
         if (finite_r(size)) {
             height = size * q;
             j->height_m = height;
@@ -902,22 +1002,38 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         }
 
         /* is this a flight at all? (walking bumps, standing, noise) */
-        bool flight_like = plausible_fall(f, &fr, size);
+        gs_real gsize = finite_r(size) ? size : gate_size(f, in_lo);
+        bool flight_like = plausible_fall(f, &fr, gsize);
         if (!flight_like) goto done;
+        f->last_land_us = T1;
+        /* a body measured without a size: its flight is still a flight (its height unknown) */
+        bool sizeless_ok = !IS_RIGID(f) && feet;
+        if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
 
-        if (n_in < f->cfg->min_samples || T1 - T0 < f->min_flight_us)
+        if (F1 != GS_T_NONE && finite_r(gsize) && floor_on < floor_before - FALL_REL * (float)gsize)
+            j->reason = GS_REJ_FALL;
+        else if (feet_contradict)
+            j->reason = GS_REJ_NO_FEET_FLIGHT;
+        else if (n_in < f->cfg->min_samples || T1 - T0 < f->min_flight_us)
             j->reason = GS_REJ_FEW_SAMPLES;
         else if (max_gap_in > f->max_gap_us)
             j->reason = GS_REJ_GAP;
-        else if (!finite_r(size))
+        else if (!finite_r(size) && !sizeless_ok)
             j->reason = GS_REJ_NO_SIZE;
-        else if (fr.rms_px > (gs_real)f->cfg->max_rms_rel * size)
+        else if (finite_r(gsize) && fr.rms_px > (gs_real)f->cfg->max_rms_rel * gsize)
             j->reason = GS_REJ_LARGE_RESIDUAL;
         else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)f->cfg->max_a_se_rel))
             j->reason = GS_REJ_UNCERTAIN_A;
-        else if (height < (gs_real)f->cfg->size_min_m || height > (gs_real)f->cfg->size_max_m)
+        else if (!gravity_agrees(f, &fr))
+            j->reason = GS_REJ_GRAVITY_DIR;
+        else if (finite_r(height) && (height < (gs_real)f->cfg->size_min_m || height > (gs_real)f->cfg->size_max_m))
             j->reason = GS_REJ_IMPLAUSIBLE_A;
         j->accepted = j->reason == GS_REJ_NONE;
+        /* the same posture at both ends puts the COM at the same height (feet times only) */
+        if (feet && finite_r(gsize)) {
+            gs_real du = fit_u_at(&fr, T1) - fit_u_at(&fr, T0);
+            if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) j->warnings |= GS_WARN_COM_MISMATCH;
+        }
 
         if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
@@ -986,6 +1102,16 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     }
     if (!(s->upright >= STAND_UPRIGHT)) return;
     if (s->t_us - f->still_since_us < STAND_SETTLE_US) return;  /* settled, not rising onto the toes */
+    /* sizes are kept for one place: where the feet stand on another floor row, afresh */
+    float floor = f->feet_on ? gs_feet_floor_px(&f->feet) : NAN;
+    if (floor == floor) {
+        bool same = f->stand_floor_epoch == f->feet.epoch && f->stand_floor_px == f->stand_floor_px;
+        if (!same || GS_FABSR((gs_real)(floor - f->stand_floor_px)) > DEPTH_TOL_REL * (gs_real)s->size_px) {
+            if (same) f->stand_n = f->stand_next = f->loose_n = f->loose_next = 0;
+            f->stand_floor_px = floor;
+            f->stand_floor_epoch = f->feet.epoch;
+        }
+    }
     keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_us = s->t_us;
     /* body axis -> image up, until flights measure gravity directly */
@@ -1019,6 +1145,7 @@ void gs_flight_forget_body(gs_flight *f)
     f->loose_n = f->loose_next = 0;
     f->stand_last_us = GS_T_NONE;
     f->still_since_us = GS_T_NONE;
+    f->stand_floor_px = NAN;
     if (!f->up_from_flight) f->up_n = 0;
 }
 

@@ -8,6 +8,13 @@
 
 #include "gs_dbits.h"
 
+/* the layout's foot points: toes (BlazePose-33: they leave the floor last and meet it first),
+ * else ankles (COCO-17); their lift at the instant a foot leaves, x stature: a toe rolls up on
+ * its tip by about 1.5 cm, an ankle rides a plantarflexed foot about 9 cm above its rest */
+#define TOE_LIFT_REL   0.009f
+#define ANKLE_LIFT_REL 0.064f
+static const uint8_t k_feet_kp[][2] = {{0, 0}, {15, 16}, {31, 32}};  /* by gs_layout */
+
 #define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~((size_t)(a) - 1u))
 
 size_t gs_pipeline_storage_bytes(const gs_core_config *cfg)
@@ -48,11 +55,11 @@ static void on_flight_event(void *ctx, const gs_event *ev)
     emit(p, ev);
     if (ev->type != GS_EV_JUMP) return;
     if (GS_WITH_POSE && p->sessions) gs_session_jump(&p->session, &ev->u.jump);
-    if (ev->u.jump.accepted) {
+    if (!ev->u.jump.accepted) {
+        gs_agg_reject(&p->agg);
+    } else if (isfinite(ev->u.jump.height_m)) {  /* a jump of unknown stature (no_size, depth_changed) adds none */
         gs_agg_add(&p->agg, ev->u.jump.height_m, ev->u.jump.height_se_m);
         emit_height(p, GS_EV_HEIGHT, ev->u.jump.track);
-    } else {
-        gs_agg_reject(&p->agg);
     }
 }
 
@@ -78,8 +85,12 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     p->sessions = GS_WITH_POSE && layout != GS_LAYOUT_POINT;
     if (GS_WITH_POSE)
         gs_session_init(&p->session, gs_time_us_of_cfg_s(cfg->session_absence_s), (gs_real)cfg->session_new_body_rel);
-    return gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
-                          on_flight_event, p);
+    st = gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
+                        on_flight_event, p);
+    if (st == GS_OK && layout != GS_LAYOUT_POINT)
+        gs_flight_use_feet(&p->flight, layout == GS_LAYOUT_BLAZEPOSE33 ? TOE_LIFT_REL : ANKLE_LIFT_REL,
+                           layout == GS_LAYOUT_BLAZEPOSE33);
+    return st;
 }
 
 void gs_pipeline_set_track(gs_pipeline *p, uint32_t track)
@@ -126,7 +137,7 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
     if (r & GS_SESSION_STARTED) emit_session(p, false, NULL);
 }
 
-static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
+static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const float *feet_xy)
 {
     if (p->finished) return GS_ESTATE;
     if (s->t_us == GS_T_NONE) return GS_EINVAL;
@@ -143,6 +154,7 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s)
         gs_flight_break(&p->flight);
     gs_status st = gs_ring_push(&p->ring, s);
     if (st != GS_OK) return st;
+    if (feet_xy) gs_flight_feet(&p->flight, s->t_us, feet_xy, feet_xy + GS_FEET_POINTS, s->size_px);
     if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
@@ -175,7 +187,14 @@ gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_k
     s.up_x = c.up_x;
     s.up_y = c.up_y;
     s.upright = c.upright;
-    return push_sample(p, &s);
+    float feet[2 * GS_FEET_POINTS];  /* x then y of each point, NaN missing */
+    for (int k = 0; k < GS_FEET_POINTS; k++) {
+        const gs_kp *f = &kp[k_feet_kp[p->layout][k]];
+        bool seen = p->layout != GS_LAYOUT_POINT && f->c >= p->cfg.min_conf && f->c > 0.0f;
+        feet[k] = seen ? f->x_px : NAN;
+        feet[GS_FEET_POINTS + k] = seen ? f->y_px : NAN;
+    }
+    return push_sample(p, &s, feet);
 }
 
 gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, float y_px,
@@ -191,7 +210,7 @@ gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, fl
     s.up_x = NAN;
     s.up_y = NAN;
     s.upright = 1.0f;
-    return push_sample(p, &s);
+    return push_sample(p, &s, NULL);
 }
 
 /* t_s in microseconds for push_sample: not finite -> GS_T_NONE (GS_EINVAL); finite

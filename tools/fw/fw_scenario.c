@@ -93,6 +93,7 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     g_cfg = k_baked;
     g_status = 0;
 #endif
+    if (!pose && !GS_WITH_POINT) return 0u; /* no point layout built in: no ball workload */
 #if GS_WITH_POSE
     const gs_layout layout = pose ? FW_POSE_LAYOUT : GS_LAYOUT_POINT;
 #else

@@ -1,0 +1,80 @@
+/* gs_feet.h - when the feet leave the floor and meet it again, sub-frame, from two foot
+ * keypoints per frame (the toes of BlazePose-33, the ankles of COCO-17), streaming.
+ *
+ * Each point's height along the image's up direction is followed. While it rests (still
+ * for GS_FEET_REST_US) its floor level is learnt; it lifts when it rises `delta` above that
+ * level (the height the point stands above its rest at the instant the foot leaves: a toe
+ * rolls up on its tip, an ankle rides a plantarflexed foot) and the crossing is
+ * interpolated between the frames around it. A touch is the mirror image: for toes where
+ * the falling point is stopped by the floor (its level then known from the stop), for
+ * ankles where the falling point passes its take-off level again (the heel comes down
+ * only later). The latest lifts and touches are kept with their levels for the flight
+ * module, which picks those around each flight (gs_feet_takeoff, gs_feet_landing).
+ * No heap; about 200 bytes. */
+#ifndef GS_FEET_H
+#define GS_FEET_H
+
+#include "gs_types.h"
+#include "gs_time.h"
+
+#define GS_FEET_POINTS 2   /* left and right */
+#define GS_FEET_HIST 8     /* frames of history per point (the stillness lag and the crossings) */
+#define GS_FEET_LOG 2      /* lifts and touches kept per point */
+#define GS_FEET_REST_US 100000  /* still this long: resting on the floor */
+
+typedef struct {
+    int64_t t_us;              /* GS_T_NONE: empty */
+    float level_px;            /* the floor it left (lift) or met (touch) */
+    float from_px;             /* touch: the floor it had rested on before */
+} gs_feet_event;
+
+typedef struct {
+    float u_px[GS_FEET_HIST];  /* heights along up, NaN missing (slot = frame % GS_FEET_HIST) */
+    float rest_px;             /* current floor level, NaN unknown */
+    float floor_px;            /* the level it last rested on long enough (armed), NaN none */
+    uint32_t rest_for_us;      /* how long it has rested so far (0: not resting) */
+    int64_t armed_from_us, armed_to_us; /* the latest run of frames resting on the floor (armed) */
+    uint16_t rest_n;           /* samples averaged into rest_px */
+    uint8_t armed;             /* rested long enough, at or near its level: a rise is a lift */
+    uint8_t lift_pending;      /* armed and above its lift level last frame: a lift if this one is too */
+    uint8_t lifted;            /* lifted and not back yet (for the recrossing touch) */
+    uint8_t touch_unsure;      /* the newest touch awaits frames that stay at its level (1: a stop, 2: a recrossing) */
+    gs_feet_event lift[GS_FEET_LOG], touch[GS_FEET_LOG];  /* newest first */
+} gs_foot;
+
+typedef struct {
+    uint32_t t_us[GS_FEET_HIST];/* frame times of the history slots, microseconds modulo 2^32 */
+    uint32_t n;                 /* frames pushed */
+    int64_t t_last_us;          /* the newest frame's time, whole */
+    int64_t unseen_us;          /* the latest frame with a point missing, GS_T_NONE none */
+    float up_x, up_y;           /* direction the heights are measured along */
+    uint16_t epoch;             /* counts the changes of that direction (levels of one epoch compare) */
+    bool stop_touch;            /* touch where the point stops (toes), else where it recrosses (ankles) */
+    float delta_rel;            /* lift at the instant of leaving, x stature */
+    gs_foot pt[GS_FEET_POINTS];
+} gs_feet;
+
+/* delta_rel: the point's height above its rest when the foot leaves, as a fraction of
+ * stature; stop_touch: see above. */
+void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch);
+/* One frame: the two points' image positions x_px[i], y_px[i] (NaN missing), the up
+ * direction (unit) and the body's size in px (stature; NaN unknown: the frame is skipped).
+ * A change of up by more than about a degree forgets the levels (they were measured along
+ * the old direction). Frames must come in time order, less than 35 min apart. */
+void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
+                  const float y_px[GS_FEET_POINTS], gs_real up_x, gs_real up_y, gs_real size_px);
+/* The take-off: both points' last lifts in [from_us, to_us), neither back on the floor
+ * before the other left; the later of the two, their mean floor level in *level_px.
+ * GS_T_NONE when not both lifted there. */
+int64_t gs_feet_takeoff(const gs_feet *ft, int64_t from_us, int64_t to_us, float *level_px);
+/* The landing: the earliest touch in (from_us, to_us], the floor level it met in *level_px
+ * and the one that point had rested on before in *before_px. GS_T_NONE when none. */
+int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float *level_px, float *before_px);
+/* Did a point rest on the floor at t_us (its latest resting run covers it)? */
+bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us);
+/* Were both points seen in every frame since t_us (and before it)? */
+bool gs_feet_seen_since(const gs_feet *ft, int64_t t_us);
+/* The floor the feet rest on now (the mean of the resting points' levels), NaN when neither rests. */
+float gs_feet_floor_px(const gs_feet *ft);
+
+#endif

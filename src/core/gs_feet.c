@@ -1,0 +1,276 @@
+/* gs_feet.c - lifts and touches of two foot points against their floor level (gs_feet.h). */
+#include "gravscale/gs_feet.h"
+
+#include <math.h>
+#include <string.h>
+
+/* thresholds in units of the body's size (stature, px) */
+#define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
+#define FAST_REL    0.5f   /* a falling foot meets the floor faster than this x size per second */
+#define MARGIN_REL  0.01f  /* a lift is confirmed this far above its crossing level (noise) */
+#define STOP_RATIO  3.0f   /* stopped: falling less than a third as fast as the frame before */
+#define REST_MIN_N  3u     /* ... and at least this many resting samples */
+#define LAG_US      100000u /* stillness: the height against the frame about this far back */
+#define UP_COS_MIN  0.9998f /* cos 1.15 deg: a larger turn of up forgets the levels */
+#define RISE_REST_K 3       /* a floor higher than the last one must be rested on this many times longer
+                             * (stepping onto a box takes long; a foot at its apex in the air is still briefly) */
+/* the touch by recrossing serves ankles (COCO-17) only: a build without that layout has none */
+#define RECROSS GS_WITH_COCO17
+
+static bool fin(float v) { return v == v && v - v == 0.0f; }
+
+/* the tracking state of a point, not its logged events */
+static void reset_track(gs_foot *f)
+{
+    for (int k = 0; k < GS_FEET_HIST; k++) f->u_px[k] = NAN;
+    f->rest_px = f->floor_px = NAN;
+    f->rest_for_us = 0;
+    f->armed_from_us = f->armed_to_us = GS_T_NONE;
+    f->rest_n = 0;
+    f->armed = f->lift_pending = f->lifted = f->touch_unsure = 0;
+}
+
+void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
+{
+    memset(ft, 0, sizeof *ft);
+    ft->up_y = -1.0f;
+    ft->delta_rel = delta_rel;
+    ft->stop_touch = stop_touch;
+    ft->t_last_us = ft->unseen_us = GS_T_NONE;
+    for (int p = 0; p < GS_FEET_POINTS; p++) {
+        reset_track(&ft->pt[p]);
+        for (int k = 0; k < GS_FEET_LOG; k++) ft->pt[p].lift[k].t_us = ft->pt[p].touch[k].t_us = GS_T_NONE;
+    }
+}
+
+/* the newest event first; from_px only for touches */
+static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float from_px)
+{
+    memmove(ev + 1, ev, (GS_FEET_LOG - 1) * sizeof *ev);
+    ev->t_us = t_us;
+    ev->level_px = level_px;
+    ev->from_px = from_px;
+}
+
+/* slot of the frame `back` frames before the newest (0: the newest) */
+static unsigned slot(const gs_feet *ft, uint32_t back) { return (ft->n - 1u - back) % GS_FEET_HIST; }
+
+/* frames held in the history */
+static uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST ? ft->n : GS_FEET_HIST; }
+
+/* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
+static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(ft, 0)] - ft->t_us[slot(ft, back)]; }
+
+/* The newest crossing of level L by the point within the history, rising (up) or falling,
+ * interpolated between the two frames around it; GS_T_NONE when none. */
+static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up)
+{
+    for (uint32_t b = 0; b + 1 < held(ft); b++) {
+        float u0 = f->u_px[slot(ft, b + 1)], u1 = f->u_px[slot(ft, b)];
+        bool hit = up ? (u0 <= L && u1 > L) : (u0 > L && u1 <= L);  /* false for NaN */
+        if (!hit) continue;
+        uint32_t a0 = age_us(ft, b + 1), a1 = age_us(ft, b);
+        float w = (L - u0) / (u1 - u0);
+        return ft->t_last_us - (int64_t)a0 + (int32_t)(w * (float)(a0 - a1) + 0.5f);
+    }
+    return GS_T_NONE;
+}
+
+/* still: the height u_now moved less than STILL_REL x size per second against the frame
+ * about LAG_US back (the oldest held when the history is shorter) */
+static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_px)
+{
+    uint32_t n = held(ft), b = 1;
+    if (n < 2) return false;
+    while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
+    float du = u_now - f->u_px[slot(ft, b)];
+    return GS_FABS(du) < STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;  /* false for NaN */
+}
+
+/* speed over the interval ending `back` frames before the newest, px/s (NaN unknown) */
+static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
+{
+    if (back + 2 > held(ft)) return NAN;
+    uint32_t dt = age_us(ft, back + 1) - age_us(ft, back);
+    return (f->u_px[slot(ft, back)] - f->u_px[slot(ft, back + 1)]) / ((float)dt * 1e-6f);
+}
+
+/* the median of the point's last three heights (a lone outlier does not move it); the newest
+ * alone when fewer are known */
+static float med3_now(const gs_feet *ft, const gs_foot *f)
+{
+    float a = f->u_px[slot(ft, 0)];
+    if (held(ft) < 3) return a;
+    float b = f->u_px[slot(ft, 1)], c = f->u_px[slot(ft, 2)];
+    if (!fin(b) || !fin(c)) return a;
+    if (a > b) { float t = a; a = b; b = t; }
+    if (b > c) b = c;
+    return a > b ? a : b;
+}
+
+static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float size_px)
+{
+    float d = ft->delta_rel * size_px, margin = MARGIN_REL * size_px;
+    bool stop_touch = !RECROSS || ft->stop_touch;
+    if (!fin(u)) return;  /* a missing frame changes nothing */
+    /* a floor holds the point: the frame after a stop stays at its level; after a recrossing
+     * (ankles) the heel comes down onto that level, not past it */
+    if (f->touch_unsure) {
+        if (u < f->touch[0].level_px - (float)f->touch_unsure * margin) {
+            memmove(f->touch, f->touch + 1, (GS_FEET_LOG - 1) * sizeof f->touch[0]);  /* it fell on */
+            f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
+            f->touch_unsure = 0;
+        } else if (f->touch_unsure == 1 || !(speed(ft, f, 0) < 0.0f)) {
+            f->touch_unsure = 0;
+        }
+    }
+    /* a lift: it rested, and rose clearly past its level plus delta in two frames running
+     * (one is an outlier) */
+    bool above = u > f->rest_px + d + margin;
+    if (f->armed && above && f->lift_pending) {
+        int64_t tc = crossing_us(ft, f, f->rest_px + d, true);
+        if (tc != GS_T_NONE) {
+            log_event(f->lift, tc, f->rest_px, NAN);
+            f->lifted = 1;
+        }
+        f->armed = 0;
+    }
+    f->lift_pending = f->armed && above;
+    /* a touch by the stop: falling fast, then (nearly) stopped by the floor (for ankles only
+     * well below the level they left: a lower floor) */
+    float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);
+    if (v1 < -FAST_REL * size_px && v2 > v1 / STOP_RATIO && (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
+        int64_t tc = crossing_us(ft, f, u + d, false);
+        if (tc != GS_T_NONE) {
+            log_event(f->touch, tc, u, f->floor_px);
+            f->touch_unsure = 1;
+            f->lifted = 0;
+        }
+    }
+    /* a touch by the recrossing (ankles): back down through the level it left, plus delta */
+    if (RECROSS && !stop_touch && f->lifted && u <= f->floor_px + d) {
+        int64_t tc = crossing_us(ft, f, f->floor_px + d, false);
+        if (tc != GS_T_NONE) {
+            log_event(f->touch, tc, f->floor_px, f->floor_px);
+            f->touch_unsure = 2;
+        }
+        f->lifted = 0;
+    }
+    /* the floor level: what the point rests on at its lowest (median heights: an outlier is
+     * no step). A rest below it is a new floor, one far above it too (stepping up); a slow
+     * rise in between (a heel or a toe rolling up before take-off) is leaving it */
+    float m = med3_now(ft, f);
+    bool st = still(ft, f, m, size_px);
+    bool resting = st && m <= f->rest_px + margin;  /* still throughout, at its level */
+    if (st && (!fin(f->rest_px) || m < f->rest_px - 2.0f * margin || m > f->rest_px + 3.0f * d + margin)) {
+        f->rest_px = m;  /* a new floor */
+        f->rest_n = 0;
+        resting = true;
+        f->rest_for_us = 0;
+    } else {
+        f->rest_for_us = resting ? f->rest_for_us + (age_us(ft, 1)) : 0u;
+    }
+    if (resting) {
+        uint32_t k = f->rest_n < 32u ? f->rest_n : 32u;
+        f->rest_px += (m - f->rest_px) / (float)(k + 1u);
+        if (f->rest_n < 0xFFFFu) f->rest_n++;
+    }
+    uint32_t need_us = f->rest_px > f->floor_px + 3.0f * d + margin ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
+    bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
+    bool was = f->armed;
+    f->armed = (rested && m <= f->rest_px + d) || (f->armed && (u <= f->rest_px + d + margin || f->lift_pending));
+    if (f->armed) {
+        f->floor_px = f->rest_px;
+        if (!was) f->armed_from_us = t_us;
+        f->armed_to_us = t_us;
+    }
+}
+
+void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
+                  const float y_px[GS_FEET_POINTS], gs_real up_x, gs_real up_y, gs_real size_px)
+{
+    if (!(size_px > 0) || !(size_px < INFINITY) || t_us == GS_T_NONE) return;
+    if (ft->t_last_us != GS_T_NONE && t_us <= ft->t_last_us) return;
+    float ux = (float)up_x, uy = (float)up_y;
+    if (!(ux * ft->up_x + uy * ft->up_y >= UP_COS_MIN)) {
+        /* heights along another direction: the levels go, the logged events stay */
+        for (int p = 0; p < GS_FEET_POINTS; p++) reset_track(&ft->pt[p]);
+        ft->epoch++;
+        ft->up_x = ux;
+        ft->up_y = uy;
+    }
+    unsigned s = ft->n % GS_FEET_HIST;
+    ft->n++;
+    ft->t_us[s] = (uint32_t)t_us;
+    ft->t_last_us = t_us;
+    for (int p = 0; p < GS_FEET_POINTS; p++) {
+        gs_foot *f = &ft->pt[p];
+        float u = x_px[p] * ux + y_px[p] * uy;
+        if (!fin(u)) ft->unseen_us = t_us;
+        f->u_px[s] = u;
+        point_step(ft, f, t_us, u, (float)size_px);
+    }
+}
+
+int64_t gs_feet_takeoff(const gs_feet *ft, int64_t from_us, int64_t to_us, float *level_px)
+{
+    int64_t lift[GS_FEET_POINTS], best = GS_T_NONE;
+    float sum = 0.0f;
+    if (level_px) *level_px = NAN;
+    for (int p = 0; p < GS_FEET_POINTS; p++) {
+        const gs_feet_event *e = ft->pt[p].lift;
+        int k = 0;  /* newest first: each point's last lift in the window */
+        while (k < GS_FEET_LOG && !(e[k].t_us != GS_T_NONE && e[k].t_us >= from_us && e[k].t_us < to_us)) k++;
+        if (k == GS_FEET_LOG) return GS_T_NONE;  /* both feet must have left */
+        lift[p] = e[k].t_us;
+        sum += e[k].level_px;
+        if (lift[p] > best) best = lift[p];
+    }
+    /* in the air together: neither came down before the other left (a step is no flight) */
+    for (int p = 0; p < GS_FEET_POINTS; p++)
+        for (int k = 0; k < GS_FEET_LOG; k++) {
+            int64_t t = ft->pt[p].touch[k].t_us;
+            if (t != GS_T_NONE && t > lift[p] && t < best) return GS_T_NONE;
+        }
+    if (level_px) *level_px = sum / (float)GS_FEET_POINTS;
+    return best;
+}
+
+int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float *level_px, float *before_px)
+{
+    const gs_feet_event *best = NULL;
+    for (int p = 0; p < GS_FEET_POINTS; p++)
+        for (int k = 0; k < GS_FEET_LOG; k++) {
+            const gs_feet_event *e = &ft->pt[p].touch[k];
+            if (e->t_us != GS_T_NONE && e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
+                best = e;
+        }
+    if (level_px) *level_px = best ? best->level_px : NAN;
+    if (before_px) *before_px = best ? best->from_px : NAN;
+    return best ? best->t_us : GS_T_NONE;
+}
+
+bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us)
+{
+    for (int p = 0; p < GS_FEET_POINTS; p++) {
+        const gs_foot *f = &ft->pt[p];
+        if (f->armed_from_us != GS_T_NONE && f->armed_from_us <= t_us && t_us <= f->armed_to_us) return true;
+    }
+    return false;
+}
+
+bool gs_feet_seen_since(const gs_feet *ft, int64_t t_us)
+{
+    return ft->n > 0 && (ft->unseen_us == GS_T_NONE || ft->unseen_us < t_us);
+}
+
+float gs_feet_floor_px(const gs_feet *ft)
+{
+    float sum = 0.0f;
+    int n = 0;
+    for (int p = 0; p < GS_FEET_POINTS; p++) {
+        const gs_foot *f = &ft->pt[p];
+        if (f->armed && fin(f->rest_px)) { sum += f->rest_px; n++; }
+    }
+    return n ? sum / (float)n : NAN;
+}
