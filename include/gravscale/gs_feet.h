@@ -39,6 +39,8 @@ typedef struct {
     uint8_t lift_pending;      /* armed and above its lift level last frame: a lift if this one is too */
     uint8_t lifted;            /* lifted and not back yet (for the recrossing touch) */
     uint8_t touch_unsure;      /* the newest touch awaits frames that stay at its level (1: a stop, 2: a recrossing) */
+    uint8_t falling;           /* still falling, not slowed since its newest touch (a recrossing) */
+    float touch_v_px_s;        /* its speed at that touch */
     gs_feet_event lift[GS_FEET_LOG], touch[GS_FEET_LOG];  /* newest first */
 } gs_foot;
 

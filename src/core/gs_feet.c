@@ -27,7 +27,8 @@ static void reset_track(gs_foot *f)
     f->rest_for_us = 0;
     f->armed_from_us = f->armed_to_us = GS_T_NONE;
     f->rest_n = 0;
-    f->armed = f->lift_pending = f->lifted = f->touch_unsure = 0;
+    f->armed = f->lift_pending = f->lifted = f->touch_unsure = f->falling = 0;
+    f->touch_v_px_s = 0.0f;
 }
 
 void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
@@ -139,6 +140,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* a touch by the stop: falling fast, then (nearly) stopped by the floor (for ankles only
      * well below the level they left: a lower floor) */
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);
+    /* the floor slows the point at once; in the air it goes on falling as fast or faster */
+    f->falling = v2 < 0.8f * f->touch_v_px_s;
     if (v1 < -FAST_REL * size_px && v2 > v1 / STOP_RATIO && (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
         int64_t tc = crossing_us(ft, f, u + d, false);
         if (tc != GS_T_NONE) {
@@ -153,6 +156,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         if (tc != GS_T_NONE) {
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
+            f->touch_v_px_s = v2;
+            f->falling = 1;
         }
         f->lifted = 0;
     }
@@ -242,6 +247,8 @@ int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float
     for (int p = 0; p < GS_FEET_POINTS; p++)
         for (int k = 0; k < GS_FEET_LOG; k++) {
             const gs_feet_event *e = &ft->pt[p].touch[k];
+            /* a recrossing the point is still falling fast past is not a landing (yet) */
+            if (k == 0 && ft->pt[p].touch_unsure == 2 && ft->pt[p].falling) continue;
             if (e->t_us != GS_T_NONE && e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
                 best = e;
         }

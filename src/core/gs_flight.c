@@ -73,6 +73,7 @@
 /* the feet (body layouts) */
 #define FEET_BEFORE_COM_US 150000     /* the feet's take-off and landing lie after the COM's boundary minus this */
 #define FEET_AFTER_COM_US  100000     /* ... and the landing before the COM's plus this (the COM keeps falling a frame or two) */
+#define FEET_FREE_EDGE_US 50000      /* the fit takes samples this far past the feet's boundaries (30-60 ms of push-off below body weight) */
 #define CONTACT_MAX_US   1000000      /* a rebound leaves the ground within this of the landing (drop jumps: 0.2-0.9 s) */
 #define DEPTH_TOL_REL    GS_R(0.015)  /* standing at the flight's place: its floor row within this x size */
 #define FALL_REL         0.05f        /* landed this x size below the floor it left: a fall from a box, not a jump */
@@ -902,9 +903,16 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
             feet_contradict = gs_feet_resting_at(&f->feet, apex_us) || (F0 != GS_T_NONE && F1 == GS_T_NONE);
     }
-    /* the fit's samples: strictly inside the COM's (T0, T1), every sample the parabola explains */
-    uint64_t in_lo = trim_edge(f, lo, hi, T0, -1, L);
-    uint64_t in_hi = trim_edge(f, hi, in_lo, T1, +1, R);
+    /* with the feet's times: the flight and the nearly free frames beside it (the push-off's
+     * last tens of ms, when the ground already bears less than the weight; the first of the
+     * landing) as far as the parabola explains them */
+    int64_t W0 = T0, W1 = T1;
+    if (F0 != GS_T_NONE && F1 != GS_T_NONE) {
+        W0 = F0 - FEET_FREE_EDGE_US;
+        W1 = F1 + FEET_FREE_EDGE_US;
+    }
+    uint64_t in_lo = trim_edge(f, lo, hi, W0, -1, L);
+    uint64_t in_hi = trim_edge(f, hi, in_lo, W1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
 
