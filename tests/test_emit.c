@@ -28,9 +28,9 @@ typedef struct {
     char str[160];
     bool b;
     int arr_n;          /* arrays: numbers, strings or nulls */
-    int arr_kind[8];
-    double arr_num[8];
-    char arr_str[8][32];
+    int arr_kind[16];
+    double arr_num[16];
+    char arr_str[16][32];
 } jv;
 
 static const char *j_ws(const char *s) { return s; } /* our lines carry no whitespace */
@@ -160,7 +160,7 @@ static int json_line(const char *s, jv *out, int max)
                 v->kind = JV_ARR;
                 if (*s != ']') {
                     for (;;) {
-                        if (v->arr_n == 8) return -1;
+                        if (v->arr_n == 16) return -1;
                         bool bb;
                         int k = v->arr_n++;
                         s = j_scalar(s, &v->arr_kind[k], &v->arr_num[k], v->arr_str[k], 32, &bb);
@@ -245,6 +245,9 @@ static gs_event ev_jump(void)
     j->height_se_m = 0.01234;
     j->jump_height_m = 0.26704;
     j->takeoff_velocity_m_s = 2.28876;
+    j->com_rise_m = 0.26699;
+    j->contact_time_s = NAN;
+    j->rsi = NAN;
     j->n_samples = 14;
     j->n_outliers = 1;
     j->rms_px = 0.87651;
@@ -294,30 +297,33 @@ void test_json_exact_lines(void)
                     "\"flight_time_s\":0.4666,\"t_apex_s\":12.5790,\"a_px_s2\":2345.68,\"a_px_se_s2\":12.3457,"
                     "\"g_dir_deg\":-1.23,\"q_m_per_px\":0.00418214,\"size_px\":412.35,\"height_m\":1.7245,"
                     "\"height_se_m\":0.0123,\"jump_height_m\":0.2670,\"takeoff_velocity_m_s\":2.289,"
-                    "\"n_samples\":14,\"n_outliers\":1,\"rms_px\":0.877,\"accepted\":true,\"reason\":null,"
+                    "\"com_rise_m\":0.2670,\"contact_time_s\":null,\"rsi\":null,\"n_samples\":14,\"n_outliers\":1,\"rms_px\":0.877,\"accepted\":true,\"reason\":null,"
                     "\"warnings\":[]}\n");
     e.u.jump.accepted = false;
     e.u.jump.reason = GS_REJ_UNCERTAIN_A;
-    e.u.jump.warnings = GS_WARN_FEW_SAMPLES | GS_WARN_OUTLIERS | GS_WARN_CLIPPED | 0x200u; /* unknown bit */
+    e.u.jump.warnings = GS_WARN_FEW_SAMPLES | GS_WARN_OUTLIERS | GS_WARN_CLIPPED | 0x8000u; /* unknown bit */
     e.u.jump.height_m = NAN;
     e.u.jump.height_se_m = INFINITY;
     e.u.jump.q_m_per_px = 1.5e-05;
     e.u.jump.a_px_s2 = 654321.4;
     e.u.jump.t_takeoff_us = GS_T_NONE; /* unknown */
+    e.u.jump.contact_time_s = 0.31249;
+    e.u.jump.rsi = 0.85456;
     check_exact(&e, "{\"event\":\"jump\",\"track\":0,\"index\":3,\"t_takeoff_s\":null,\"t_land_s\":12.8123,"
                     "\"flight_time_s\":0.4666,\"t_apex_s\":12.5790,\"a_px_s2\":654321,\"a_px_se_s2\":12.3457,"
                     "\"g_dir_deg\":-1.23,\"q_m_per_px\":1.5e-05,\"size_px\":412.35,\"height_m\":null,"
                     "\"height_se_m\":null,\"jump_height_m\":0.2670,\"takeoff_velocity_m_s\":2.289,"
-                    "\"n_samples\":14,\"n_outliers\":1,\"rms_px\":0.877,\"accepted\":false,"
+                    "\"com_rise_m\":0.2670,\"contact_time_s\":0.3125,\"rsi\":0.855,\"n_samples\":14,\"n_outliers\":1,\"rms_px\":0.877,\"accepted\":false,"
                     "\"reason\":\"uncertain_acceleration\",\"warnings\":[\"few_samples\",\"outliers\","
                     "\"edge_truncated\"]}\n");
-    e.u.jump.warnings = 0x1FFu;
+    e.u.jump.warnings = 0x1FFFu;
     e.u.jump.reason = GS_REJ_GAP;
     char buf[GS_EMIT_MAX];
     gs_emit_json(&e, buf, sizeof buf);
     TEST_ASSERT_NOT_NULL(strstr(buf, "\"reason\":\"gap\",\"warnings\":[\"few_samples\",\"gravity_tilt\","
                                      "\"size_changed\",\"outliers\",\"edge_truncated\",\"camera_moved\","
-                                     "\"left_frame\",\"out_of_plane\",\"other_motion\"]}\n"));
+                                     "\"left_frame\",\"out_of_plane\",\"other_motion\",\"no_size\",\"depth_changed\","
+                                     "\"com_timed\",\"com_mismatch\"]}\n"));
 
     memset(&e, 0, sizeof e);
     e.type = GS_EV_HEIGHT;
@@ -393,8 +399,8 @@ void test_json_exact_lines(void)
 static const char *const k_jump_keys[] = {
     "event",     "track",    "index",       "t_takeoff_s", "t_land_s", "flight_time_s", "t_apex_s",
     "a_px_s2",   "a_px_se_s2", "g_dir_deg", "q_m_per_px",  "size_px",  "height_m",      "height_se_m",
-    "jump_height_m", "takeoff_velocity_m_s", "n_samples", "n_outliers", "rms_px", "accepted", "reason",
-    "warnings"};
+    "jump_height_m", "takeoff_velocity_m_s", "com_rise_m", "contact_time_s", "rsi", "n_samples", "n_outliers",
+    "rms_px", "accepted", "reason", "warnings"};
 
 static double rnd_val(int i)
 {
@@ -428,7 +434,7 @@ void test_json_jump_roundtrip_random(void)
         gs_ev_jump *j = &e.u.jump;
         gs_real *d[] = {&j->flight_time_s, &j->a_px_s2, &j->a_px_se_s2, &j->g_dir_deg, &j->q_m_per_px,
                         &j->size_px, &j->height_m, &j->height_se_m, &j->jump_height_m, &j->takeoff_velocity_m_s,
-                        &j->rms_px};
+                        &j->com_rise_m, &j->contact_time_s, &j->rsi, &j->rms_px};
         for (size_t k = 0; k < sizeof d / sizeof d[0]; k++) *d[k] = rnd_val(it + (int)k * 3 + (int)(rnd_unit() * 5));
         int64_t *tm[] = {&j->t_takeoff_us, &j->t_land_us, &j->t_apex_us};
         for (size_t k = 0; k < 3; k++) *tm[k] = rnd_time(it + (int)k);
@@ -437,14 +443,14 @@ void test_json_jump_roundtrip_random(void)
         j->n_samples = (uint32_t)(rnd_unit() * 4e9);
         j->n_outliers = (uint32_t)(rnd_unit() * 100);
         j->accepted = rnd_unit() < 0.5;
-        j->reason = (gs_reject_reason)(rnd_unit() * 7);
-        j->warnings = (uint32_t)(rnd_unit() * 32);
+        j->reason = (gs_reject_reason)(rnd_unit() * 11);
+        j->warnings = (uint32_t)(rnd_unit() * 8192);
         size_t n = gs_emit_json(&e, buf, sizeof buf);
         TEST_ASSERT_TRUE(n > 0 && n < GS_EMIT_MAX);
         jv v[32];
         int nv = json_line(buf, v, 32);
-        TEST_ASSERT_EQUAL_INT_MESSAGE(22, nv, buf);
-        for (int k = 0; k < 22; k++) TEST_ASSERT_EQUAL_STRING(k_jump_keys[k], v[k].key);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(25, nv, buf);
+        for (int k = 0; k < 25; k++) TEST_ASSERT_EQUAL_STRING(k_jump_keys[k], v[k].key);
         TEST_ASSERT_EQUAL_DOUBLE((double)j->index, v[2].num);
         check_num(v, nv, "t_takeoff_s", gs_time_s_of_us(j->t_takeoff_us), 0.5e-4, 0);
         check_num(v, nv, "t_land_s", gs_time_s_of_us(j->t_land_us), 0.5e-4, 0);
@@ -459,6 +465,9 @@ void test_json_jump_roundtrip_random(void)
         check_num(v, nv, "height_se_m", j->height_se_m, 0.5e-4, 0);
         check_num(v, nv, "jump_height_m", j->jump_height_m, 0.5e-4, 0);
         check_num(v, nv, "takeoff_velocity_m_s", j->takeoff_velocity_m_s, 0.5e-3, 0);
+        check_num(v, nv, "com_rise_m", j->com_rise_m, 0.5e-4, 0);
+        check_num(v, nv, "contact_time_s", j->contact_time_s, 0.5e-4, 0);
+        check_num(v, nv, "rsi", j->rsi, 0.5e-3, 0);
         check_num(v, nv, "rms_px", j->rms_px, 0.5e-3, 0);
         TEST_ASSERT_EQUAL_DOUBLE((double)j->n_samples, find(v, nv, "n_samples")->num);
         const jv *acc = find(v, nv, "accepted");
@@ -472,7 +481,7 @@ void test_json_jump_roundtrip_random(void)
         }
         const jv *wr = find(v, nv, "warnings");
         int bits = 0;
-        for (uint32_t b = 0; b < 5; b++) bits += (j->warnings >> b) & 1u;
+        for (uint32_t b = 0; b < 13; b++) bits += (j->warnings >> b) & 1u;
         TEST_ASSERT_EQUAL_INT(bits, wr->arr_n);
     }
 }
@@ -716,12 +725,12 @@ void test_json_widest_events_fit(void)
     j->flight_time_s = F;
     j->a_px_s2 = j->a_px_se_s2 = j->q_m_per_px = S;
     j->g_dir_deg = j->size_px = j->height_m = j->height_se_m = j->jump_height_m = F;
-    j->takeoff_velocity_m_s = j->rms_px = F;
+    j->takeoff_velocity_m_s = j->com_rise_m = j->contact_time_s = j->rsi = j->rms_px = F;
     j->accepted = false;
     j->reason = GS_REJ_IMPLAUSIBLE_A;
-    j->warnings = 0xFFu;
+    j->warnings = 0x1FFFu;
     size_t n = gs_emit_json(&e, buf, sizeof buf);
-    TEST_ASSERT_EQUAL_UINT64(738, n); /* its three times at their widest are 2 characters narrower than F */
+    TEST_ASSERT_EQUAL_UINT64(907, n); /* its three times at their widest are 2 characters narrower than F */
     jv v[32];
     TEST_ASSERT_TRUE_MESSAGE(json_line(buf, v, 32) > 0, buf);
 

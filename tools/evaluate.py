@@ -177,6 +177,7 @@ def score_trial(trial, run):
             a, b = j.get(key), f.get(key)
             return (a - b) * scale if _finite(a) and _finite(b) else None
         timing.append({"flight": fi, "jump_height_cm": diff("jump_height_m", 100.0),
+                       "com_rise_cm": diff("com_rise_m", 100.0),
                        "flight_time_ms": diff("flight_time_s", 1000.0),
                        "takeoff_velocity_m_s": diff("takeoff_velocity_m_s", 1.0)})
     return {

@@ -21,6 +21,7 @@
 #define GS_FEET_HIST 8     /* frames of history per point (the stillness lag and the crossings) */
 #define GS_FEET_LOG 2      /* lifts and touches kept per point */
 #define GS_FEET_REST_US 100000  /* still this long: resting on the floor */
+#define GS_FEET_SINK_REL 0.05f  /* a floor this x stature below the last one is a lower floor (a box's height) */
 
 typedef struct {
     int64_t t_us;              /* GS_T_NONE: empty */
@@ -33,7 +34,8 @@ typedef struct {
     float rest_px;             /* current floor level, NaN unknown */
     float floor_px;            /* the level it last rested on long enough (armed), NaN none */
     uint32_t rest_for_us;      /* how long it has rested so far (0: not resting) */
-    int64_t armed_from_us, armed_to_us; /* the latest run of frames resting on the floor (armed) */
+    int64_t rested_from_us, rested_to_us; /* the latest run of frames on the floor (gs_feet_resting_at) */
+    int64_t sank_us;           /* the latest frame it was well below the floor it had rested on, GS_T_NONE none */
     uint16_t rest_n;           /* samples averaged into rest_px */
     uint8_t armed;             /* rested long enough, at or near its level: a rise is a lift */
     uint8_t lift_pending;      /* armed and above its lift level last frame: a lift if this one is too */
@@ -47,7 +49,7 @@ typedef struct {
 typedef struct {
     uint32_t t_us[GS_FEET_HIST];/* frame times of the history slots, microseconds modulo 2^32 */
     uint32_t n;                 /* frames pushed */
-    int64_t t_last_us;          /* the newest frame's time, whole */
+    int64_t t_last_us, t_prev_us; /* the newest frame's time and the one before, whole */
     int64_t unseen_us;          /* the latest frame with a point missing, GS_T_NONE none */
     float up_x, up_y;           /* direction the heights are measured along */
     uint16_t epoch;             /* counts the changes of that direction (levels of one epoch compare) */
@@ -72,8 +74,12 @@ int64_t gs_feet_takeoff(const gs_feet *ft, int64_t from_us, int64_t to_us, float
 /* The landing: the earliest touch in (from_us, to_us], the floor level it met in *level_px
  * and the one that point had rested on before in *before_px. GS_T_NONE when none. */
 int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float *level_px, float *before_px);
-/* Did a point rest on the floor at t_us (its latest resting run covers it)? */
+/* Was a point on the floor at t_us: resting still, or a toe not yet risen clear of its floor
+ * (ankles ride up and down on a plantarflexed foot: only resting counts)? */
 bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us);
+/* Did a point sink well below the floor it had rested on (GS_FEET_SINK_REL x stature: a
+ * step or a fall to a lower floor, which no jump does) at or after t_us? */
+bool gs_feet_sank_since(const gs_feet *ft, int64_t t_us);
 /* Were both points seen in every frame since t_us (and before it)? */
 bool gs_feet_seen_since(const gs_feet *ft, int64_t t_us);
 /* The floor the feet rest on now (the mean of the resting points' levels), NaN when neither rests. */

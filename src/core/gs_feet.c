@@ -3,6 +3,9 @@
 
 #include <math.h>
 #include <string.h>
+#ifdef GS_FEET_DEBUG
+#include <stdio.h>
+#endif
 
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
@@ -25,7 +28,7 @@ static void reset_track(gs_foot *f)
     for (int k = 0; k < GS_FEET_HIST; k++) f->u_px[k] = NAN;
     f->rest_px = f->floor_px = NAN;
     f->rest_for_us = 0;
-    f->armed_from_us = f->armed_to_us = GS_T_NONE;
+    f->rested_from_us = f->rested_to_us = f->sank_us = GS_T_NONE;
     f->rest_n = 0;
     f->armed = f->lift_pending = f->lifted = f->touch_unsure = f->falling = 0;
     f->touch_v_px_s = 0.0f;
@@ -37,7 +40,7 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
     ft->up_y = -1.0f;
     ft->delta_rel = delta_rel;
     ft->stop_touch = stop_touch;
-    ft->t_last_us = ft->unseen_us = GS_T_NONE;
+    ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         reset_track(&ft->pt[p]);
         for (int k = 0; k < GS_FEET_LOG; k++) ft->pt[p].lift[k].t_us = ft->pt[p].touch[k].t_us = GS_T_NONE;
@@ -180,14 +183,18 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         f->rest_px += (m - f->rest_px) / (float)(k + 1u);
         if (f->rest_n < 0xFFFFu) f->rest_n++;
     }
-    uint32_t need_us = f->rest_px > f->floor_px + 3.0f * d + margin ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
+    uint32_t need_us = f->rest_px > f->floor_px + d + GS_FEET_SINK_REL * size_px ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
     bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
-    bool was = f->armed;
     f->armed = (rested && m <= f->rest_px + d) || (f->armed && (u <= f->rest_px + d + margin || f->lift_pending));
-    if (f->armed) {
-        f->floor_px = f->rest_px;
-        if (!was) f->armed_from_us = t_us;
-        f->armed_to_us = t_us;
+#ifdef GS_FEET_DEBUG
+    if (f->armed && f->floor_px != f->rest_px) fprintf(stderr, "floor %s t=%lld %.1f -> %.1f (u %.1f m %.1f)\n", f == &ft->pt[0] ? "L" : "R", (long long)t_us, f->floor_px, f->rest_px, u, m);
+#endif
+    if (f->armed) f->floor_px = f->rest_px;
+    if (m < f->floor_px - d - GS_FEET_SINK_REL * size_px) f->sank_us = t_us;  /* (an ankle may rest delta up, on its toes) */
+    /* on the floor: still there, or (toes) not yet risen clear of it since; the run of such frames */
+    if (rested || (stop_touch && f->armed)) {
+        if (f->rested_to_us != ft->t_prev_us) f->rested_from_us = t_us;
+        f->rested_to_us = t_us;
     }
 }
 
@@ -207,6 +214,7 @@ void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
     unsigned s = ft->n % GS_FEET_HIST;
     ft->n++;
     ft->t_us[s] = (uint32_t)t_us;
+    ft->t_prev_us = ft->t_last_us;
     ft->t_last_us = t_us;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         gs_foot *f = &ft->pt[p];
@@ -261,8 +269,15 @@ bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us)
 {
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         const gs_foot *f = &ft->pt[p];
-        if (f->armed_from_us != GS_T_NONE && f->armed_from_us <= t_us && t_us <= f->armed_to_us) return true;
+        if (f->rested_from_us != GS_T_NONE && f->rested_from_us <= t_us && t_us <= f->rested_to_us) return true;
     }
+    return false;
+}
+
+bool gs_feet_sank_since(const gs_feet *ft, int64_t t_us)
+{
+    for (int p = 0; p < GS_FEET_POINTS; p++)
+        if (ft->pt[p].sank_us != GS_T_NONE && ft->pt[p].sank_us >= t_us) return true;
     return false;
 }
 

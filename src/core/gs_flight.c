@@ -74,9 +74,9 @@
 #define FEET_BEFORE_COM_US 150000     /* the feet's take-off and landing lie after the COM's boundary minus this */
 #define FEET_AFTER_COM_US  100000     /* ... and the landing before the COM's plus this (the COM keeps falling a frame or two) */
 #define FEET_FREE_EDGE_US 50000      /* the fit takes samples this far past the feet's boundaries (30-60 ms of push-off below body weight) */
+#define FALL_FLOOR_REL   0.1f         /* landed this x size below the floor it left (a box, 20-60 cm): a fall, not a jump; less is a jump toward the camera */
 #define CONTACT_MAX_US   1000000      /* a rebound leaves the ground within this of the landing (drop jumps: 0.2-0.9 s) */
 #define DEPTH_TOL_REL    GS_R(0.015)  /* standing at the flight's place: its floor row within this x size */
-#define FALL_REL         0.05f        /* landed this x size below the floor it left: a fall from a box, not a jump */
 #define COM_MISMATCH_REL GS_R(0.04)   /* the COM at landing this x size off its take-off height: flagged */
 #define GRAV_DIR_SE_K    GS_R(2.0)    /* gravity's direction may differ from the expected by this many SE ... */
 #define GRAV_DIR_MIN_DEG GS_R(8.0)    /* ... plus this (a standing body's axis leans a few degrees, most seen from the side) */
@@ -885,6 +885,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     float floor_off = NAN, floor_on = NAN, floor_before = NAN;
     int64_t F0 = GS_T_NONE, F1 = GS_T_NONE;
     bool feet_contradict = false;  /* the feet, in view, show no flight there */
+    bool fell = false;             /* ... or a fall to a lower floor */
     if (f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
         int64_t apex_us = fit_apex_us(&r);
         int64_t c0 = T0 != GS_T_NONE ? T0 : t_at(f, L), c1 = T1 != GS_T_NONE ? T1 : t_at(f, R);
@@ -902,6 +903,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
          * rested, as in quick hops, say nothing: the COM times the flight) */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
             feet_contradict = gs_feet_resting_at(&f->feet, apex_us) || (F0 != GS_T_NONE && F1 == GS_T_NONE);
+        fell = F0 == GS_T_NONE && gs_feet_sank_since(&f->feet, c0);  /* (a clean take-off is checked by its landing floor) */
     }
     /* with the feet's times: the flight and the nearly free frames beside it (the push-off's
      * last tens of ms, when the ground already bears less than the weight; the first of the
@@ -1018,7 +1020,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
 
-        if (F1 != GS_T_NONE && finite_r(gsize) && floor_on < floor_before - FALL_REL * (float)gsize)
+        if (fell || (F1 != GS_T_NONE && finite_r(gsize) && floor_on < floor_before - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
         else if (feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;

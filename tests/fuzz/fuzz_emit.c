@@ -81,7 +81,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         j->t_apex_us = fz_time(&in);
         gs_real *d[] = {&j->flight_time_s, &j->a_px_s2, &j->a_px_se_s2, &j->g_dir_deg, &j->q_m_per_px,
                         &j->size_px, &j->height_m, &j->height_se_m, &j->jump_height_m, &j->takeoff_velocity_m_s,
-                        &j->rms_px};
+                        &j->com_rise_m, &j->contact_time_s, &j->rsi, &j->rms_px};
         for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) *d[i] = (gs_real)fz_double(&in);
         j->n_samples = fz_u32(&in);
         j->n_outliers = fz_u32(&in);

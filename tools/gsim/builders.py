@@ -184,7 +184,9 @@ class Builder:
             ax, ay = q[0], q[1]
         self.flights.append({
             "t_takeoff_s": t0, "t_land_s": tL, "flight_time_s": tau,
-            "t_apex_s": t0 + v0z / G, "jump_height_m": v0z * v0z / (2 * G),
+            "t_apex_s": t0 + v0z / G,
+            "jump_height_m": G * tau * tau / 8.0,        # from the flight time, as mats and apps report
+            "com_rise_m": v0z * v0z / (2 * G),            # the COM's rise to the apex, as force plates report
             "takeoff_velocity_m_s": v0z,
             "takeoff_velocity_h_m_s": math.hypot(vxy[0], vxy[1]),
         })
