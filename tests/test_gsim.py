@@ -131,6 +131,8 @@ class Motions(unittest.TestCase):
                                                     "r_ball", "r_toe"))
                     self.assertAlmostEqual(low, 0.0, places=9, msg="%s t=%.3f" % (key, t))
                     continue
+                if ph.support == "both":  # standing and jumping: the toes are support points too
+                    feet.update({n: pts[n] for n in ("l_toe", "r_toe")})
                 sup = [n for n in feet if ph.support == "both" or n[0] == ph.support.lower()]
                 self.assertAlmostEqual(min(feet[n][2] for n in sup), 0.0, places=9,
                                        msg="%s t=%.3f" % (key, t))

@@ -18,7 +18,7 @@
 #include "gs_time.h"
 
 #define GS_FEET_POINTS 2   /* left and right */
-#define GS_FEET_HIST 8     /* frames of history per point (the stillness lag and the crossings) */
+#define GS_FEET_HIST 10    /* frames of history per point (the stillness lag and the crossings; two wait) */
 #define GS_FEET_LOG 2      /* lifts and touches kept per point */
 #define GS_FEET_REST_US 100000  /* still this long: resting on the floor */
 #define GS_FEET_SINK_REL 0.05f  /* a floor this x stature below the last one is a lower floor (a box's height) */
@@ -48,7 +48,10 @@ typedef struct {
 
 typedef struct {
     uint32_t t_us[GS_FEET_HIST];/* frame times of the history slots, microseconds modulo 2^32 */
-    uint32_t n;                 /* frames pushed */
+    uint32_t n;                 /* frames examined */
+    uint8_t pending;            /* the newest frame waits for the next (outlier test) */
+    int64_t pend_t_us;          /* its time */
+    float pend_size_px;         /* its body size */
     int64_t t_last_us, t_prev_us; /* the newest frame's time and the one before, whole */
     int64_t unseen_us;          /* the latest frame with a point missing, GS_T_NONE none */
     float up_x, up_y;           /* direction the heights are measured along */
@@ -64,9 +67,13 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch);
 /* One frame: the two points' image positions x_px[i], y_px[i] (NaN missing), the up
  * direction (unit) and the body's size in px (stature; NaN unknown: the frame is skipped).
  * A change of up by more than about a degree forgets the levels (they were measured along
- * the old direction). Frames must come in time order, less than 35 min apart. */
+ * the old direction). Frames must come in time order, less than 35 min apart. Each frame is
+ * examined when the next arrives (a lone outlier is told by its neighbours): events lag
+ * one frame; gs_feet_flush examines the last. */
 void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
                   const float y_px[GS_FEET_POINTS], gs_real up_x, gs_real up_y, gs_real size_px);
+/* The stream ends (or pauses): examine the frame that waits for the next. */
+void gs_feet_flush(gs_feet *ft);
 /* The take-off: both points' last lifts in [from_us, to_us), neither back on the floor
  * before the other left; the later of the two, their mean floor level in *level_px.
  * GS_T_NONE when not both lifted there. */

@@ -19,6 +19,7 @@
                              * (stepping onto a box takes long; a foot at its apex in the air is still briefly) */
 /* the touch by recrossing serves ankles (COCO-17) only: a build without that layout has none */
 #define RECROSS GS_WITH_COCO17
+#define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
 
 static bool fin(float v) { return v == v && v - v == 0.0f; }
 
@@ -59,8 +60,8 @@ static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float fro
 /* slot of the frame `back` frames before the newest (0: the newest) */
 static unsigned slot(const gs_feet *ft, uint32_t back) { return (ft->n - 1u - back) % GS_FEET_HIST; }
 
-/* frames held in the history */
-static uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST ? ft->n : GS_FEET_HIST; }
+/* frames held in the history (two slots are the pending frame and the one after it) */
+static uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - 2u ? ft->n : GS_FEET_HIST - 2u; }
 
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(ft, 0)] - ft->t_us[slot(ft, back)]; }
@@ -160,7 +161,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
             f->touch_v_px_s = v2;
-            f->falling = 1;
+            f->falling = 0;  /* the next frame tells */
         }
         f->lifted = 0;
     }
@@ -198,31 +199,58 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     }
 }
 
+/* Examine the pending frame (slot n), once the one after it (next, NaN-free or NULL at the
+ * end) shows whether it was a lone outlier: a height away from both neighbours, the same
+ * way, by more than SPIKE_REL of the size (feet do not jump there and back in a frame). */
+static void process_pending(gs_feet *ft, const float *next)
+{
+    unsigned s = ft->n % GS_FEET_HIST;
+    float size = ft->pend_size_px, spike = SPIKE_REL * size;
+    for (int p = 0; p < GS_FEET_POINTS && next && ft->n > 0; p++) {
+        float a = ft->pt[p].u_px[slot(ft, 0)], b = ft->pt[p].u_px[s], c = next[p];
+        if ((b - a > spike && b - c > spike) || (a - b > spike && c - b > spike)) ft->pt[p].u_px[s] = NAN;
+    }
+    ft->n++;
+    ft->t_prev_us = ft->t_last_us;
+    ft->t_last_us = ft->pend_t_us;
+    for (int p = 0; p < GS_FEET_POINTS; p++) {
+        float u = ft->pt[p].u_px[s];
+        if (!fin(u)) ft->unseen_us = ft->t_last_us;
+        point_step(ft, &ft->pt[p], ft->t_last_us, u, size);
+    }
+    ft->pending = 0;
+}
+
+void gs_feet_flush(gs_feet *ft)
+{
+    if (ft->pending) process_pending(ft, NULL);
+}
+
 void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
                   const float y_px[GS_FEET_POINTS], gs_real up_x, gs_real up_y, gs_real size_px)
 {
     if (!(size_px > 0) || !(size_px < INFINITY) || t_us == GS_T_NONE) return;
-    if (ft->t_last_us != GS_T_NONE && t_us <= ft->t_last_us) return;
+    int64_t last = ft->pending ? ft->pend_t_us : ft->t_last_us;
+    if (last != GS_T_NONE && t_us <= last) return;
     float ux = (float)up_x, uy = (float)up_y;
     if (!(ux * ft->up_x + uy * ft->up_y >= UP_COS_MIN)) {
         /* heights along another direction: the levels go, the logged events stay */
+        gs_feet_flush(ft);
         for (int p = 0; p < GS_FEET_POINTS; p++) reset_track(&ft->pt[p]);
         ft->epoch++;
         ft->up_x = ux;
         ft->up_y = uy;
     }
-    unsigned s = ft->n % GS_FEET_HIST;
-    ft->n++;
-    ft->t_us[s] = (uint32_t)t_us;
-    ft->t_prev_us = ft->t_last_us;
-    ft->t_last_us = t_us;
-    for (int p = 0; p < GS_FEET_POINTS; p++) {
-        gs_foot *f = &ft->pt[p];
-        float u = x_px[p] * ux + y_px[p] * uy;
-        if (!fin(u)) ft->unseen_us = t_us;
-        f->u_px[s] = u;
-        point_step(ft, f, t_us, u, (float)size_px);
-    }
+    float u[GS_FEET_POINTS];
+    for (int p = 0; p < GS_FEET_POINTS; p++) u[p] = x_px[p] * ux + y_px[p] * uy;
+    /* this frame waits in the slot after the pending one until the next shows it is no outlier */
+    unsigned w = (ft->n + ft->pending) % GS_FEET_HIST;
+    ft->t_us[w] = (uint32_t)t_us;
+    for (int p = 0; p < GS_FEET_POINTS; p++) ft->pt[p].u_px[w] = u[p];
+    if (ft->pending) process_pending(ft, u);
+    ft->pending = 1;
+    ft->pend_t_us = t_us;
+    ft->pend_size_px = (float)size_px;
 }
 
 int64_t gs_feet_takeoff(const gs_feet *ft, int64_t from_us, int64_t to_us, float *level_px)

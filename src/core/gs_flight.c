@@ -887,6 +887,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     bool feet_contradict = false;  /* the feet, in view, show no flight there */
     bool fell = false;             /* ... or a fall to a lower floor */
     if (f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
+        gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(&r);
         int64_t c0 = T0 != GS_T_NONE ? T0 : t_at(f, L), c1 = T1 != GS_T_NONE ? T1 : t_at(f, R);
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
@@ -1347,6 +1348,7 @@ void gs_flight_update(gs_flight *f)
 void gs_flight_break(gs_flight *f)
 {
     gs_flight_update(f);
+    if (f->feet_on) gs_feet_flush(&f->feet);
     /* what the next sample would do on seeing the gap, while the ring still holds the flight */
     if (f->state == GS_FS_AIRBORNE) {
         close_candidate(f, f->last_idx, UINT64_MAX, true);
@@ -1357,6 +1359,7 @@ void gs_flight_break(gs_flight *f)
 void gs_flight_finish(gs_flight *f)
 {
     gs_flight_update(f);
+    if (f->feet_on) gs_feet_flush(&f->feet);
     if (f->state == GS_FS_AIRBORNE) {
         close_candidate(f, f->last_idx, UINT64_MAX, true);
         set_state(f, GS_FS_GROUND, f->last_t_us);

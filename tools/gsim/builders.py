@@ -134,8 +134,10 @@ class Builder:
                 break
             tau = nt
         allf = ("l_heel", "l_ball", "r_heel", "r_ball")
-        names = (("l_heel", "l_ball") if support_land in ("both", "L") else ()) + \
-                (("r_heel", "r_ball") if support_land in ("both", "R") else ())
+        # both feet land on their toes first (a jump); one foot (a running step) on its ball
+        toe = support_land == "both"
+        names = (("l_heel", "l_ball") + (("l_toe",) if toe else ()) if support_land in ("both", "L") else ()) + \
+                (("r_heel", "r_ball") + (("r_toe",) if toe else ()) if support_land in ("both", "R") else ())
         for _ in range(8):
             bake()
             flight_keys(t0, tau)
@@ -229,8 +231,8 @@ class Builder:
         arm_back = -u(35, 75) * D2R
         arm_to = (u(100, 165) if kind != "low" else u(20, 100)) * D2R
         dl = 0.0 if sym else u(-25, 25) * D2R
-        s_to = u(0.10, 0.22)
-        ph_to = u(18, 35) * D2R
+        s_to = u(0.16, 0.28)  # knees a little bent at toe-off: the plantarflexed foot carries the rest of the reach
+        ph_to = u(36, 48) * D2R  # toe-off on a steep foot: the ankle about 0.06 x stature above its flat level, as motion capture shows
         lean_b = u(22, 42) * D2R * (dip / 0.3) ** 0.5
         self.key(tb - 0.04, af_L=arm_back + dl, af_R=arm_back - dl, el_L=u(10, 35) * D2R,
                  el_R=u(10, 35) * D2R, aa_L=self.rest["aa_L"], aa_R=self.rest["aa_R"])
@@ -267,7 +269,7 @@ class Builder:
                    "bend": u(-12, 12) * D2R, "aa_L": u(10, 120) * D2R, "aa_R": u(10, 120) * D2R,
                    "dc": u(-0.3, 0.3), "af_L": u(-20, 170) * D2R, "af_R": u(-20, 170) * D2R}
         c_L = u(0.08, 0.22)
-        ph_L = u(5, 22) * D2R
+        ph_L = u(34, 46) * D2R  # toes first, the heel about as high as at take-off (motion capture)
         af_L = u(20, 80) * D2R
         lean_L = u(3, 12) * D2R
         apex_af = arm_to + u(0, 20) * D2R

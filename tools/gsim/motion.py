@@ -72,7 +72,7 @@ def _solve3(A, b):
 
 def _support_pts(support):
     if support == "both":
-        return ("l_heel", "l_ball", "r_heel", "r_ball"), ("l_ball", "r_ball")
+        return ("l_heel", "l_ball", "l_toe", "r_heel", "r_ball", "r_toe"), ("l_ball", "r_ball")
     s = "l_" if support == "L" else "r_"
     return (s + "heel", s + "ball"), (s + "ball",)
 
