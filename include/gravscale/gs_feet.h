@@ -41,8 +41,8 @@ typedef struct {
     uint8_t lift_pending;      /* armed and above its lift level last frame: a lift if this one is too */
     uint8_t lifted;            /* lifted and not back yet (for the recrossing touch) */
     uint8_t touch_unsure;      /* the newest touch awaits frames that stay at its level (1: a stop, 2: a recrossing) */
-    uint8_t falling;           /* still falling, not slowed since its newest touch (a recrossing) */
-    float touch_v_px_s;        /* its speed at that touch */
+    uint8_t falling;           /* falling fast in the newest frame after a recrossing (then in the air, not on a heel) */
+    float low_px;              /* its lowest height since its latest lift, NaN before one */
     gs_feet_event lift[GS_FEET_LOG], touch[GS_FEET_LOG];  /* newest first */
 } gs_foot;
 
@@ -87,6 +87,10 @@ bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us);
 /* Did a point sink well below the floor it had rested on (GS_FEET_SINK_REL x stature: a
  * step or a fall to a lower floor, which no jump does) at or after t_us? */
 bool gs_feet_sank_since(const gs_feet *ft, int64_t t_us);
+/* Is a point in the air (lifted and not yet back, or an ankle's recrossing not yet settled)? */
+bool gs_feet_airborne(const gs_feet *ft);
+/* The lowest height of the points since their latest lifts (NaN when none lifted). */
+float gs_feet_low_px(const gs_feet *ft);
 /* Were both points seen in every frame since t_us (and before it)? */
 bool gs_feet_seen_since(const gs_feet *ft, int64_t t_us);
 /* The floor the feet rest on now (the mean of the resting points' levels), NaN when neither rests. */

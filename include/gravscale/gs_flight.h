@@ -86,6 +86,8 @@ typedef struct {
     float stand_floor_px;      /* the feet's floor level while the kept standing sizes were taken, NaN unknown */
     uint16_t stand_floor_epoch;/* ... measured in this epoch of the feet's direction */
     int64_t last_land_us;      /* the latest landing (of a jump or a fall), GS_T_NONE none */
+    int64_t feet_wait_us;      /* the COM landed: wait until then for the feet, GS_T_NONE not waiting */
+    uint64_t wait_alarm;       /* ... the contact alarm it landed with */
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,

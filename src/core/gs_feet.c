@@ -10,6 +10,7 @@
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
 #define FAST_REL    0.5f   /* a falling foot meets the floor faster than this x size per second */
+#define FALL_REL    1.0f   /* ... and still falls this fast after a recrossing only in the air (a heel drops slower) */
 #define MARGIN_REL  0.01f  /* a lift is confirmed this far above its crossing level (noise) */
 #define STOP_RATIO  3.0f   /* stopped: falling less than a third as fast as the frame before */
 #define REST_MIN_N  3u     /* ... and at least this many resting samples */
@@ -32,7 +33,7 @@ static void reset_track(gs_foot *f)
     f->rested_from_us = f->rested_to_us = f->sank_us = GS_T_NONE;
     f->rest_n = 0;
     f->armed = f->lift_pending = f->lifted = f->touch_unsure = f->falling = 0;
-    f->touch_v_px_s = 0.0f;
+    f->low_px = NAN;
 }
 
 void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
@@ -118,12 +119,14 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float d = ft->delta_rel * size_px, margin = MARGIN_REL * size_px;
     bool stop_touch = !RECROSS || ft->stop_touch;
     if (!fin(u)) return;  /* a missing frame changes nothing */
+    if (u < f->low_px) f->low_px = u;  /* (NaN before a lift: no change) */
     /* a floor holds the point: the frame after a stop stays at its level; after a recrossing
      * (ankles) the heel comes down onto that level, not past it */
     if (f->touch_unsure) {
         if (u < f->touch[0].level_px - (float)f->touch_unsure * margin) {
             memmove(f->touch, f->touch + 1, (GS_FEET_LOG - 1) * sizeof f->touch[0]);  /* it fell on */
             f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
+            f->lifted = f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
             f->touch_unsure = 0;
         } else if (f->touch_unsure == 1 || !(speed(ft, f, 0) < 0.0f)) {
             f->touch_unsure = 0;
@@ -137,6 +140,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         if (tc != GS_T_NONE) {
             log_event(f->lift, tc, f->rest_px, NAN);
             f->lifted = 1;
+            f->low_px = u;
         }
         f->armed = 0;
     }
@@ -144,8 +148,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* a touch by the stop: falling fast, then (nearly) stopped by the floor (for ankles only
      * well below the level they left: a lower floor) */
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);
-    /* the floor slows the point at once; in the air it goes on falling as fast or faster */
-    f->falling = v2 < 0.8f * f->touch_v_px_s;
+    /* the floor slows the point at once (a heel comes down at well under a stature per second); in the air it falls on */
+    f->falling = v2 < -FALL_REL * size_px;
     if (v1 < -FAST_REL * size_px && v2 > v1 / STOP_RATIO && (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
         int64_t tc = crossing_us(ft, f, u + d, false);
         if (tc != GS_T_NONE) {
@@ -160,7 +164,6 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         if (tc != GS_T_NONE) {
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
-            f->touch_v_px_s = v2;
             f->falling = 0;  /* the next frame tells */
         }
         f->lifted = 0;
@@ -307,6 +310,22 @@ bool gs_feet_sank_since(const gs_feet *ft, int64_t t_us)
     for (int p = 0; p < GS_FEET_POINTS; p++)
         if (ft->pt[p].sank_us != GS_T_NONE && ft->pt[p].sank_us >= t_us) return true;
     return false;
+}
+
+bool gs_feet_airborne(const gs_feet *ft)
+{
+    /* (an ankle's recrossing is a landing only once its heel is down or it stops falling) */
+    for (int p = 0; p < GS_FEET_POINTS; p++)
+        if (ft->pt[p].lifted || ft->pt[p].touch_unsure == 2) return true;
+    return false;
+}
+
+float gs_feet_low_px(const gs_feet *ft)
+{
+    float low = NAN;
+    for (int p = 0; p < GS_FEET_POINTS; p++)
+        if (ft->pt[p].low_px == ft->pt[p].low_px && !(ft->pt[p].low_px >= low)) low = ft->pt[p].low_px;
+    return low;
 }
 
 bool gs_feet_seen_since(const gs_feet *ft, int64_t t_us)

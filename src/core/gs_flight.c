@@ -75,6 +75,7 @@
 #define FEET_AFTER_COM_US  100000     /* ... and the landing before the COM's plus this (the COM keeps falling a frame or two) */
 #define FEET_FREE_EDGE_US 50000      /* the fit takes samples this far past the feet's boundaries (30-60 ms of push-off below body weight) */
 #define FALL_FLOOR_REL   0.1f         /* landed this x size below the floor it left (a box, 20-60 cm): a fall, not a jump; less is a jump toward the camera */
+#define FEET_WAIT_US     100000       /* after the COM's landing, wait this long for feet still in the air */
 #define CONTACT_MAX_US   1000000      /* a rebound leaves the ground within this of the landing (drop jumps: 0.2-0.9 s) */
 #define DEPTH_TOL_REL    GS_R(0.015)  /* standing at the flight's place: its floor row within this x size */
 #define COM_MISMATCH_REL GS_R(0.04)   /* the COM at landing this x size off its take-off height: flagged */
@@ -245,6 +246,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->feet_on = false;
     gs_feet_init(&f->feet, 0.0f, true);
     f->last_land_us = GS_T_NONE;
+    f->feet_wait_us = GS_T_NONE;
     return GS_OK;
 }
 
@@ -898,13 +900,19 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         }
         DBG("feet: com %lld..%lld apex %lld -> F0 %lld F1 %lld floors %.1f %.1f before %.1f\n", (long long)c0,
             (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, floor_off, floor_on, floor_before);
+        DBG("   touches L %lld %lld R %lld %lld unsure %d %d falling %d %d\n", (long long)f->feet.pt[0].touch[0].t_us, (long long)f->feet.pt[0].touch[1].t_us, (long long)f->feet.pt[1].touch[0].t_us, (long long)f->feet.pt[1].touch[1].t_us, f->feet.pt[0].touch_unsure, f->feet.pt[1].touch_unsure, f->feet.pt[0].falling, f->feet.pt[1].falling);
         if (F0 != GS_T_NONE && F1 != GS_T_NONE && F1 <= F0) F0 = F1 = GS_T_NONE;
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
          * rested, as in quick hops, say nothing: the COM times the flight) */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
-            feet_contradict = gs_feet_resting_at(&f->feet, apex_us) || (F0 != GS_T_NONE && F1 == GS_T_NONE);
-        fell = F0 == GS_T_NONE && gs_feet_sank_since(&f->feet, c0);  /* (a clean take-off is checked by its landing floor) */
+            feet_contradict = gs_feet_resting_at(&f->feet, apex_us) ||
+                              (F0 != GS_T_NONE && F1 == GS_T_NONE && gs_feet_airborne(&f->feet));
+        /* a fall: the feet went well below the floor they left (a box): after a clean take-off
+         * below its floor, else below the floor they had rested on */
+        float d_px = f->feet.delta_rel * (float)gate_size(f, L);
+        fell = F0 != GS_T_NONE ? gs_feet_low_px(&f->feet) < floor_off - d_px - GS_FEET_SINK_REL * (float)gate_size(f, L)
+                               : gs_feet_sank_since(&f->feet, c0);
     }
     /* with the feet's times: the flight and the nearly free frames beside it (the push-off's
      * last tens of ms, when the ground already bears less than the weight; the first of the
@@ -952,8 +960,10 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
     bool feet = F0 != GS_T_NONE && F1 != GS_T_NONE;
-    if (F0 != GS_T_NONE) T0 = F0;
-    if (F1 != GS_T_NONE) T1 = F1;
+    if (feet) {  /* (one end from the feet and the other from the COM would mix two definitions) */
+        T0 = F0;
+        T1 = F1;
+    }
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -1016,7 +1026,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         gs_real gsize = finite_r(size) ? size : gate_size(f, in_lo);
         bool flight_like = plausible_fall(f, &fr, gsize);
         if (!flight_like) goto done;
-        f->last_land_us = T1;
+        f->last_land_us = F1 != GS_T_NONE ? F1 : T1;  /* (a fall's landing is the feet's, for the rebound's contact) */
         /* a body measured without a size: its flight is still a flight (its height unknown) */
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
@@ -1253,6 +1263,15 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 
 static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_full *s)
 {
+    /* the COM may turn before the feet meet the floor (its model is not the body): while a
+     * foot that left is still in the air, wait for it a little (the event still leaves well
+     * within the landing latency) */
+    if (f->feet_on && f->feet_wait_us == GS_T_NONE && gs_feet_airborne(&f->feet)) {
+        f->feet_wait_us = s->t_us + FEET_WAIT_US;
+        f->wait_alarm = alarm;
+        return;
+    }
+    f->feet_wait_us = GS_T_NONE;
     /* the running fit may hold samples past the edge: rebuild it over the flight */
     gs_fit_result r;
     refit_range(f, f->fl_first, f->fl_last, &r);
@@ -1262,6 +1281,10 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_ful
 
 static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
 {
+    if (f->feet_wait_us != GS_T_NONE) {  /* the COM landed: waiting for the feet */
+        if (s->t_us >= f->feet_wait_us || !gs_feet_airborne(&f->feet)) land(f, idx, f->wait_alarm, s);
+        return;
+    }
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
     if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_us, t_at(f, f->seed_idx), f->max_flight_us)) {
@@ -1345,23 +1368,25 @@ void gs_flight_update(gs_flight *f)
     }
 }
 
+/* the stream ends or pauses: close an open candidate (one waiting for its feet with its alarm) */
+static void end_flight(gs_flight *f)
+{
+    if (f->feet_on) gs_feet_flush(&f->feet);
+    if (f->state != GS_FS_AIRBORNE) return;
+    bool waited = f->feet_wait_us != GS_T_NONE;
+    f->feet_wait_us = GS_T_NONE;
+    close_candidate(f, f->last_idx, waited ? f->wait_alarm : UINT64_MAX, !waited);
+    set_state(f, GS_FS_GROUND, f->last_t_us);
+}
+
 void gs_flight_break(gs_flight *f)
 {
     gs_flight_update(f);
-    if (f->feet_on) gs_feet_flush(&f->feet);
-    /* what the next sample would do on seeing the gap, while the ring still holds the flight */
-    if (f->state == GS_FS_AIRBORNE) {
-        close_candidate(f, f->last_idx, UINT64_MAX, true);
-        set_state(f, GS_FS_GROUND, f->last_t_us);
-    }
+    end_flight(f);  /* what the next sample would do on seeing the gap, while the ring still holds the flight */
 }
 
 void gs_flight_finish(gs_flight *f)
 {
     gs_flight_update(f);
-    if (f->feet_on) gs_feet_flush(&f->feet);
-    if (f->state == GS_FS_AIRBORNE) {
-        close_candidate(f, f->last_idx, UINT64_MAX, true);
-        set_state(f, GS_FS_GROUND, f->last_t_us);
-    }
+    end_flight(f);
 }
