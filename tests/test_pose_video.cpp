@@ -102,7 +102,7 @@ static void test_missing_models_is_a_clear_error(void)
 
 // ---- the scene watch against synthetic truth ---------------------------------------
 
-// a jumper at 60 fps: toes on the ground row 900 px, off at t0, back at t1, flying
+// a jumper at 60 fps: feet on the ground row 900 px, off at t0, back at t1, flying
 // under a = 2000 px/s^2; the camera still or drifting; the body 600 px tall
 static void synth(gs::SceneWatch &w, double t0, double t1, double drift_px_s, double border_at,
                   double other_from = -1.0, double other_to = -1.0)
@@ -116,24 +116,18 @@ static void synth(gs::SceneWatch &w, double t0, double t1, double drift_px_s, do
         f.size_px = 600.0;
         f.cam_dx_px = drift_px_s * t;
         f.cam_dy_px = 0.0;
-        f.feet_y_px = (t > t0 && t < t1) ? g - v0 * (t - t0) + 0.5 * a * (t - t0) * (t - t0) : g;
-        f.ground_y_px = f.feet_y_px;
+        f.ground_y_px = (t > t0 && t < t1) ? g - v0 * (t - t0) + 0.5 * a * (t - t0) * (t - t0) : g;
         f.at_border = std::fabs(t - border_at) < 0.02;
         f.other = (t >= other_from && t <= other_to) ? 8 : 1;  // corners moving beside the body
         w.add(f);
     }
 }
 
-static void test_scene_watch_feet_timing_and_warnings(void)
+static void test_scene_watch_warnings(void)
 {
     const double t0 = 0.7913, t1 = 1.2871;  // between frames
     gs::SceneWatch still;
     synth(still, t0, t1, 0.0, -1.0);
-    double a0, a1;
-    TEST_ASSERT_TRUE(still.feet_flight(t0 - 0.05, t1 + 0.04, 2000.0, &a0, &a1));
-    std::printf("feet timing: take-off %+.2f ms, landing %+.2f ms\n", (a0 - t0) * 1e3, (a1 - t1) * 1e3);
-    TEST_ASSERT_DOUBLE_WITHIN(0.002, t0, a0);
-    TEST_ASSERT_DOUBLE_WITHIN(0.002, t1, a1);
     TEST_ASSERT_EQUAL_UINT32(0, still.flight_warnings(t0, t1, 0.5 * (t0 + t1)));
 
     gs::SceneWatch drift;  // 20 px/s: 10 px over the flight, above 1 % of 600 px
@@ -157,7 +151,7 @@ static void test_scene_watch_feet_timing_and_warnings(void)
 int main(void)
 {
     UNITY_BEGIN();
-    RUN_TEST(test_scene_watch_feet_timing_and_warnings);
+    RUN_TEST(test_scene_watch_warnings);
     RUN_TEST(test_gym_handheld_flight_time_and_warning);
     RUN_TEST(test_vtest_people_walking_report_nothing);
     RUN_TEST(test_missing_models_is_a_clear_error);

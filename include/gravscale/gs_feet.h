@@ -43,6 +43,7 @@ typedef struct {
     uint8_t touch_unsure;      /* the newest touch awaits frames that stay at its level (1: a stop, 2: a recrossing) */
     uint8_t falling;           /* falling fast in the newest frame after a recrossing (then in the air, not on a heel) */
     float low_px;              /* its lowest height since its latest lift, NaN before one */
+    float noise_px;            /* its jitter (1 sigma) while still, 0 unknown */
     gs_feet_event lift[GS_FEET_LOG], touch[GS_FEET_LOG];  /* newest first */
 } gs_foot;
 

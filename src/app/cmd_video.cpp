@@ -222,7 +222,6 @@ struct App {
     uint32_t emit_fail = 0;
     gs::RunRecord rec;
     gs::SceneWatch *watch = nullptr;  // pose: per-flight warnings from the frames
-    std::vector<gs_ev_jump> person_jumps;  // pose: accepted flights as printed
 };
 
 bool is_trace_event(gs_event_type t) { return t == GS_EV_STATE || t == GS_EV_SAMPLE || t == GS_EV_FIT; }
@@ -266,30 +265,6 @@ void record_event(App &a, const gs_event *ev)
     }
 }
 
-// The feet's take-off and landing (seconds) into the jump, rounded to the microsecond;
-// the flight time is the feet's own span (unrounded: the height follows it as before).
-// false (j untouched) when a time is not representable.
-bool feet_times_us(double t0_s, double t1_s, gs_ev_jump *j)
-{
-    const int64_t t0_us = gs_time_us_of_s(t0_s), t1_us = gs_time_us_of_s(t1_s);
-    if (t0_us == GS_T_NONE || t1_us == GS_T_NONE) return false;
-    j->t_takeoff_us = t0_us;
-    j->t_land_us = t1_us;
-    j->flight_time_s = t1_s - t0_s;
-    return true;
-}
-
-// A flight of the visit e: not over more than 1 s before it started nor begun more than
-// 1 s after it ended; an unknown time on either side does not exclude it.
-bool within_session(const gs_ev_jump &j, const gs_ev_session &e)
-{
-    const bool known_start = j.t_land_us != GS_T_NONE && e.t_start_us != GS_T_NONE;
-    const bool known_end = j.t_takeoff_us != GS_T_NONE && e.t_end_us != GS_T_NONE;
-    if (known_start && j.t_land_us < e.t_start_us - GS_US_PER_S) return false;
-    if (known_end && j.t_takeoff_us > e.t_end_us + GS_US_PER_S) return false;
-    return true;
-}
-
 void on_event(void *ctx, const gs_event *ev)
 {
     App &a = *static_cast<App *>(ctx);
@@ -301,41 +276,6 @@ void on_event(void *ctx, const gs_event *ev)
         // the scene watch counts in the frames' seconds; unknown times are NaN there
         const double tk_s = gs_time_s_of_us(j.t_takeoff_us), tl_s = gs_time_s_of_us(j.t_land_us);
         j.warnings |= a.watch->flight_warnings(tk_s, tl_s, gs_time_s_of_us(j.t_apex_us));
-        // a jumper's flight is the feet's: off the ground to back on it; its height by the
-        // jump-test convention h = g T^2 / 8 (the COM's rise differs by the body's shape change)
-        double t0, t1, g = j.q_m_per_px * j.a_px_s2;
-        if (a.watch->feet_flight(tk_s, tl_s, j.a_px_s2, &t0, &t1) && std::fabs(t0 - tk_s) < 0.15 &&
-            std::fabs(t1 - tl_s) < 0.15 && feet_times_us(t0, t1, &j)) {
-            if (std::isfinite(g)) {
-                j.jump_height_m = g * j.flight_time_s * j.flight_time_s / 8.0;
-                j.takeoff_velocity_m_s = 0.5 * g * j.flight_time_s;
-            }
-        }
-        if (j.accepted) a.person_jumps.push_back(j);
-        ev = &marked;
-    } else if (ev->type == GS_EV_SESSION && a.watch && ev->u.session.ended) {
-        // the visit's jump figures from the flights as printed (feet timing), not the core's
-        marked = *ev;
-        gs_ev_session &e = marked.u.session;
-        double best_h = NAN, sum_h = 0, best_t = NAN, sum_t = 0, sum_v = 0;
-        int n = 0;
-        for (const gs_ev_jump &j : a.person_jumps) {
-            if (!within_session(j, e)) continue;
-            if (!std::isfinite(j.jump_height_m) || !std::isfinite(j.flight_time_s)) continue;
-            if (!(j.jump_height_m <= best_h)) best_h = j.jump_height_m;
-            if (!(j.flight_time_s <= best_t)) best_t = j.flight_time_s;
-            sum_h += j.jump_height_m;
-            sum_t += j.flight_time_s;
-            sum_v += j.takeoff_velocity_m_s;
-            n++;
-        }
-        if (n > 0 && (uint32_t)n == e.n_jumps) {
-            e.best_jump_m = best_h;
-            e.mean_jump_m = sum_h / n;
-            e.best_flight_s = best_t;
-            e.mean_flight_s = sum_t / n;
-            e.mean_takeoff_velocity_m_s = sum_v / n;
-        }
         ev = &marked;
     }
     // a track other than 0 that never had a flight (a distractor followed for a
@@ -533,9 +473,6 @@ struct PersonFront {
                 kp[k].y_px = static_cast<float>(r.y);
             }
         }
-        // the toes (foot index 31, 32) in the core's coordinates: they leave the ground last and meet it first
-        sf->feet_y_px = (po->visibility[31] > 0.3f && po->visibility[32] > 0.3f)
-                            ? 0.5 * ((double)kp[31].y_px + (double)kp[32].y_px) : NAN;
     }
 };
 

@@ -20,6 +20,7 @@
                              * (stepping onto a box takes long; a foot at its apex in the air is still briefly) */
 /* the touch by recrossing serves ankles (COCO-17) only: a build without that layout has none */
 #define RECROSS GS_WITH_COCO17
+#define NOISE_K     3.0f   /* margins at least this many of the point's own jitter */
 #define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
 
 static bool fin(float v) { return v == v && v - v == 0.0f; }
@@ -116,9 +117,12 @@ static float med3_now(const gs_feet *ft, const gs_foot *f)
 
 static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float size_px)
 {
-    float d = ft->delta_rel * size_px, margin = MARGIN_REL * size_px;
+    float d = ft->delta_rel * size_px;
     bool stop_touch = !RECROSS || ft->stop_touch;
     if (!fin(u)) return;  /* a missing frame changes nothing */
+    /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */
+    float margin = MARGIN_REL * size_px;
+    if (NOISE_K * f->noise_px > margin) margin = NOISE_K * f->noise_px;
     if (u < f->low_px) f->low_px = u;  /* (NaN before a lift: no change) */
     /* a floor holds the point: the frame after a stop stays at its level; after a recrossing
      * (ankles) the heel comes down onto that level, not past it */
@@ -173,6 +177,11 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
      * rise in between (a heel or a toe rolling up before take-off) is leaving it */
     float m = med3_now(ft, f);
     bool st = still(ft, f, m, size_px);
+    if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
+        float d2 = GS_FABS(u - 2.0f * f->u_px[slot(ft, 1)] + f->u_px[slot(ft, 2)]) / 1.954f;
+        if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
+        if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
+    }
     bool resting = st && m <= f->rest_px + margin;  /* still throughout, at its level */
     if (st && (!fin(f->rest_px) || m < f->rest_px - 2.0f * margin || m > f->rest_px + 3.0f * d + margin)) {
         f->rest_px = m;  /* a new floor */

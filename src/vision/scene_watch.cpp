@@ -89,69 +89,6 @@ bool SceneWatch::other_rejects(double t0, double t1, double t_apex) const
     return n >= cfg_.other_frames && n >= cfg_.other_reject * frames;
 }
 
-namespace {
-// the time the feet's row y(t) = y1 + v (t - t1) + a/2 (t - t1)^2 through the
-// airborne frames (t1, y1), (t2, y2) meets the ground row g, within [lo, hi]
-double ground_crossing(double t1, double y1, double t2, double y2, double a, double g, double lo, double hi)
-{
-    double dt = t2 - t1;
-    if (dt == 0.0 || !std::isfinite(dt)) return NAN;  // t2 after t1 (take-off) or before it (landing)
-    double v = (y2 - y1 - 0.5 * a * dt * dt) / dt;
-    double A = 0.5 * a, B = v, C = y1 - g;
-    double disc = B * B - 4.0 * A * C;
-    if (disc < 0.0 || A == 0.0) return NAN;
-    double best = NAN;
-    for (int sgn = -1; sgn <= 1; sgn += 2) {
-        double tau = (-B + sgn * std::sqrt(disc)) / (2.0 * A);
-        double t = t1 + tau;
-        if (t >= lo && t <= hi && (!std::isfinite(best) || std::fabs(t - t1) < std::fabs(best - t1))) best = t;
-    }
-    return best;
-}
-}  // namespace
-
-bool SceneWatch::feet_flight(double tc0, double tc1, double a, double *t0_s, double *t1_s) const
-{
-    if (!std::isfinite(tc0) || !std::isfinite(tc1) || !(a > 0.0)) return false;
-    std::vector<double> before, after, sizes;
-    std::vector<const SceneFrame *> fr;
-    for (const SceneFrame &f : frames_) {
-        if (!std::isfinite(f.feet_y_px)) continue;
-        if (f.t_s >= tc0 - 0.5 && f.t_s <= tc0 - 0.15) before.push_back(f.feet_y_px);
-        // the event comes a landing latency (~0.2 s) after the landing: what follows it so far
-        if (f.t_s >= tc1 && f.t_s <= tc1 + 0.5) after.push_back(f.feet_y_px);
-        if (f.t_s >= tc0 - 0.5 && f.t_s <= tc1 + 0.5) {
-            fr.push_back(&f);
-            if (std::isfinite(f.size_px)) sizes.push_back(f.size_px);
-        }
-    }
-    if (before.size() < 3 || after.size() < 2 || fr.size() < 6) return false;
-    double gb = median(before), ga = median(after), size = median(sizes);
-    if (!std::isfinite(size)) return false;
-    const double thr = 0.025 * size;  // toes this far above the ground are off it
-    const double mid = 0.5 * (tc0 + tc1);
-    // the airborne run around the middle of the core's flight
-    size_t m = 0;
-    for (size_t i = 0; i < fr.size(); i++)
-        if (std::fabs(fr[i]->t_s - mid) < std::fabs(fr[m]->t_s - mid)) m = i;
-    if (!(fr[m]->feet_y_px < std::min(gb, ga) - thr)) return false;
-    size_t i0 = m, i1 = m;
-    while (i0 > 0 && fr[i0 - 1]->feet_y_px < gb - thr) i0--;
-    while (i1 + 1 < fr.size() && fr[i1 + 1]->feet_y_px < ga - thr) i1++;
-    if (i0 == 0 || i1 + 1 >= fr.size() || i1 - i0 < 2) return false;  // the ground is not seen on both sides
-    // the first frames above the threshold may be a frame or two after the feet left (slow at first)
-    double t0 = ground_crossing(fr[i0]->t_s, fr[i0]->feet_y_px, fr[i0 + 1]->t_s, fr[i0 + 1]->feet_y_px, a, gb,
-                                fr[i0 >= 3 ? i0 - 3 : 0]->t_s, fr[i0]->t_s);
-    double t1 = ground_crossing(fr[i1]->t_s, fr[i1]->feet_y_px, fr[i1 - 1]->t_s, fr[i1 - 1]->feet_y_px, a, ga,
-                                fr[i1]->t_s, fr[std::min(fr.size() - 1, i1 + 3)]->t_s);
-    // no crossing in the gap (the feet were still slowing or the parabola misses): the gap's middle
-    if (!std::isfinite(t0)) t0 = 0.5 * (fr[i0 - 1]->t_s + fr[i0]->t_s);
-    if (!std::isfinite(t1)) t1 = 0.5 * (fr[i1]->t_s + fr[i1 + 1]->t_s);
-    *t0_s = t0;
-    *t1_s = t1;
-    return true;
-}
-
 uint32_t SceneWatch::onsets()
 {
     if (frames_.empty()) return 0;

@@ -21,7 +21,6 @@ struct SceneFrame {
     bool at_border = false;      // head or feet at (or beyond) the frame's border
     double ground_y_px = 0.0;    // the feet's row (NaN unknown)
     double size_px = 0.0;        // body size this frame (NaN unknown), for thresholds
-    double feet_y_px = 0.0;      // the toes' mean row in the core's (stabilised) coordinates, NaN unknown
     int other = 0;               // corners right around the body moving against the background
 };
 
@@ -41,11 +40,6 @@ public:
     void add(const SceneFrame &f);
     // GS_WARN_* bits for a flight from t_takeoff_s to t_land_s (NaN ends: the apex +- 0.3 s)
     uint32_t flight_warnings(double t_takeoff_s, double t_land_s, double t_apex_s) const;
-    // Take-off and landing read off the feet: the toes' row leaves and meets the
-    // ground (its level before take-off and after landing), each crossing placed
-    // at sub-frame precision by the two nearest airborne frames under the flight's
-    // acceleration a_px_s2. false when the feet do not show it clearly.
-    bool feet_flight(double t_takeoff_s, double t_land_s, double a_px_s2, double *t0_s, double *t1_s) const;
     // frames of the flight's window that saw other motion beside the body, and all its frames
     int other_motion(double t_takeoff_s, double t_land_s, double t_apex_s, int *frames) const;
     // the flight is not to be trusted: other motion through other_reject of its window
