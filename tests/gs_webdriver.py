@@ -14,7 +14,7 @@ import urllib.request
 
 CHROMIUM = os.environ.get("GS_CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("GS_CHROMEDRIVER", "/usr/bin/chromedriver")
-ELEMENT = "element-6066-11e4-a52f-4a5bcf0c1a82"
+ELEMENT = "element-6066-11e4-a52e-4f735466cecf"
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
          "--disable-extensions", "--disable-default-apps", "--hide-scrollbars", "--mute-audio"]

@@ -488,7 +488,8 @@ int Kiosk::Impl::handle(mg_connection *c)
 {
     const mg_request_info *ri = mg_get_request_info(c);
     const std::string m = ri->request_method ? ri->request_method : "";
-    const std::string path = ri->local_uri ? ri->local_uri : "";
+    // the path as sent (decoded, not cleaned): only exact names match, "/a/../b" is no name
+    const std::string path = ri->local_uri_raw ? ri->local_uri_raw : "";
     const bool changes = !(m == "GET" || m == "HEAD");
     if (m != "GET" && m != "POST" && m != "PUT" && m != "PATCH" && m != "DELETE")
         return error(c, 405, "method not allowed");

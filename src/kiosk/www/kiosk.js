@@ -172,7 +172,7 @@ gs.drawTrend = (svg, jumps) => {
   const hs = ok.map((j) => j.jump_height_m * 100);
   const lo = Math.min(...hs), hi = Math.max(...hs), pad = (hi - lo) * 0.15 || 2;
   const f = gs.frame(svg, 1, Math.max(2, ok.length), Math.max(0, lo - pad), hi + pad, 'jump (oldest first)',
-                     'jump height (cm)', (v) => v.toFixed(0), (v) => v.toFixed(0));
+                     'jump height (cm)', (v) => (Number.isInteger(v) ? String(v) : ''), (v) => v.toFixed(0));
   gs.svg(svg, 'polyline', { points: ok.map((j, i) => f.X(i + 1) + ',' + f.Y(hs[i])).join(' '), class: 'trend' });
   const best = Math.max(...hs);
   ok.forEach((j, i) => {
