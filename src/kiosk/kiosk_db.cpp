@@ -202,7 +202,12 @@ bool Db::exec(const char *sql)
     return false;
 }
 
-bool Db::begin() { return exec("BEGIN IMMEDIATE"); }
+bool Db::begin()
+{
+    if (exec("BEGIN IMMEDIATE")) return true;
+    write_failed("a transaction");
+    return false;
+}
 
 bool Db::commit()
 {
