@@ -26,7 +26,8 @@ namespace gs::kiosk {
 namespace {
 
 constexpr size_t kBodyMax = 16 * 1024;
-constexpr int kKeepAliveS = 15;  // a comment line this often tells a dead live page from a quiet one
+constexpr int kKeepAliveS = 15;
+constexpr size_t kListMax = 30;  // jumps listed on the live page (the latest)  // a comment line this often tells a dead live page from a quiet one
 
 double wall_ms()
 {
@@ -124,7 +125,8 @@ struct Kiosk::Impl {
     int64_t run = 0;
     std::map<uint32_t, int64_t> open;  // track -> open visit
     std::map<uint32_t, bool> implicit; // ... opened by a jump (no visits: a ball)
-    json jumps = json::array(), status = nullptr;
+    json jumps = json::array(), best = nullptr, mean = nullptr, status = nullptr;
+    size_t n_jumps = 0;
 
     explicit Impl(const Config &c) : cfg(c), live(LiveConfig{c.result_hold_s}) {}
 
@@ -146,25 +148,19 @@ struct Kiosk::Impl {
 void Kiosk::Impl::refresh_jumps()
 {
     Filter f;
+    json all = json::array();
     if (athlete) {
         f.athlete = athlete;
         f.day = Db::today_local();
+        all = db.jumps(f);
     } else if (open.count(0)) {
         f.session = open[0];
-    } else {
-        jumps = json::array();
-        return;
+        all = db.jumps(f);
     }
-    jumps = db.jumps(f);
-    for (json &j : jumps) j.erase("event_json");
-}
-
-void Kiosk::Impl::publish()
-{
-    json best = nullptr, mean = nullptr;
+    best = mean = nullptr;
     double sum_h = 0, sum_t = 0, sum_v = 0;
     int n = 0, nt = 0, nv = 0;
-    for (const json &j : jumps) {
+    for (const json &j : all) {
         if (!j.value("accepted", false) || !j["jump_height_m"].is_number()) continue;
         double h = j["jump_height_m"].get<double>();
         if (best.is_null() || h > best["jump_height_m"].get<double>()) best = j;
@@ -172,11 +168,23 @@ void Kiosk::Impl::publish()
         if (j["flight_time_s"].is_number()) sum_t += j["flight_time_s"].get<double>(), nt++;
         if (j["takeoff_velocity_m_s"].is_number()) sum_v += j["takeoff_velocity_m_s"].get<double>(), nv++;
     }
+    if (!best.is_null()) best.erase("event_json");
     if (n)
         mean = {{"jump_height_m", sum_h / n},
                 {"flight_time_s", nt ? json(sum_t / nt) : json(nullptr)},
                 {"takeoff_velocity_m_s", nv ? json(sum_v / nv) : json(nullptr)},
                 {"n", n}};
+    // the page lists the latest; the history page has them all
+    jumps = json::array();
+    n_jumps = all.size();
+    for (size_t i = all.size() > kListMax ? all.size() - kListMax : 0; i < all.size(); i++) {
+        all[i].erase("event_json");
+        jumps.push_back(std::move(all[i]));
+    }
+}
+
+void Kiosk::Impl::publish()
+{
     const bool holding = cfg.wait_for_athlete && !athlete;
     json s = {{"seq", seq},
               {"wall_ms", wall_ms()},
@@ -188,6 +196,7 @@ void Kiosk::Impl::publish()
               {"last_jump", live.last_jump()},
               {"stature", live.stature()},
               {"jumps", jumps},
+              {"n_jumps", n_jumps},
               {"best", best},
               {"mean", mean},
               {"warnings", live.live_warnings()},
