@@ -822,7 +822,9 @@ int run(const Options &o)
             std::this_thread::sleep_for(std::chrono::milliseconds(kStepMs));
             gs_sinkset_poll(&d.sinks, gs_sink_now_s());
         }
-        d.kiosk.reset();
+        if (source_ended && g_stop)
+            std::fprintf(stderr, "gravscale: cam: %s: stopping\n", g_stop == SIGINT ? "SIGINT" : "SIGTERM");
+        d.kiosk.reset();  // civetweb's stop takes about 1 s
     }
 #endif
     uint64_t left = gs_sinkset_drain(&d.sinks, cc.drain_s);
