@@ -145,6 +145,39 @@ class CamMqtt(unittest.TestCase):
         self.assertIn("3 flights (3 accepted)", d.stderr())
         print("mqtt: %d events, %d of them while the broker was away, each once" % (len(lines), n_during))
 
+    def test_nmea_daemon_gives_mqtt_json(self):
+        """A daemon writing NMEA to its other sinks still publishes every event as JSON."""
+        sub = subprocess.Popen([SUB, "-h", "127.0.0.1", "-p", str(self.port), "-t", "gs/#", "-q", "1",
+                                "-F", "%t %p", "-W", "30"], stdout=subprocess.PIPE, text=True)
+        self.addCleanup(lambda: (sub.terminate(), sub.wait(5)))
+        time.sleep(0.3)
+        nmea_path = os.path.join(self.dir, "events.nmea")
+        cfg = os.path.join(self.dir, "nmea.cfg")
+        with open(cfg, "w") as f:
+            f.write("[core]\nformat = nmea\n[cam]\nbackend = keypoints\ndevice = %s\nrealtime = no\n"
+                    "[sink.stdout]\nenabled = no\n[sink.file]\npath = %s\n[sink.mqtt]\nhost = 127.0.0.1\n"
+                    "port = %d\ntopic_prefix = gs\ndevice = cam-2\n[status]\ninterval_s = 0\n"
+                    % (CSV, nmea_path, self.port))
+        d = Daemon(["--config", cfg], self.dir, "nmea")
+        self.addCleanup(d.stop)
+        self.assertEqual(d.proc.wait(30), 0, d.stderr())
+        time.sleep(0.5)
+        sub.terminate()
+        out = sub.communicate(timeout=5)[0].splitlines()
+        with open(nmea_path) as f:
+            nmea = f.read().splitlines()
+        self.assertTrue(all(l.startswith("$GS") for l in nmea), nmea)
+        events = [(l.split(" ", 1)[0], json.loads(l.split(" ", 1)[1])) for l in out
+                  if not l.startswith("gs/cam-2/status ")]
+        kinds = {"$GSSTA": "start", "$GSSES": "session", "$GSJMP": "jump", "$GSHGT": "height", "$GSSUM": "summary"}
+        self.assertEqual([kinds[l[:6]] for l in nmea], [e["event"] for _, e in events])
+        for topic, e in events:
+            self.assertEqual(topic, "gs/cam-2/" + e["event"])
+        # the same jumps: NMEA's height field (3 decimals) against the JSON's
+        jumps = [e for _, e in events if e["event"] == "jump"]
+        for line, e in zip([l for l in nmea if l.startswith("$GSJMP")], jumps):
+            self.assertAlmostEqual(float(line.split(",")[5]), e["height_m"], places=3)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)

@@ -83,8 +83,11 @@ class KioskApi(unittest.TestCase):
         plot = one["track_json"]
         self.assertEqual(plot["units"], "m")
         self.assertGreater(len(plot["samples"]), 10)
-        # the parabola's apex is the jump height above the take-off level (the fit's own apex)
-        self.assertAlmostEqual(plot["apex"][1], jumps[0]["jump_height_m"], delta=0.01)
+        # the drawn parabola peaks at the COM's rise from take-off to the fit's apex, g/2 (t_apex - t_takeoff)^2
+        j0 = jumps[0]
+        g = j0["a_px_s2"] * j0["q_m_per_px"]
+        self.assertAlmostEqual(plot["apex"][1], g / 2 * (j0["t_apex_s"] - j0["t_takeoff_s"]) ** 2, delta=0.002)
+        self.assertAlmostEqual(plot["apex"][0], j0["t_apex_s"] - j0["t_takeoff_s"], delta=1e-3)
         s, sess, _ = self.req("GET", "/api/sessions?athlete=%d" % aid)
         self.assertEqual(len(sess), 1)
         end = [e for e in ev if e["event"] == "session" and e["state"] == "end"][0]
