@@ -401,7 +401,7 @@ static void test_bad_profiles_one_line_exit_2(void)
 static void test_shipped_profiles_parse(void)
 {
     const char *names[] = {"kiosk", "smartcam_serial", "ball_lab", "default"};
-    const char *want[] = {"backend v4l2, device '/dev/video0', 1280x720, 60 fps, pixel format mjpeg, detector pose, format json, 1 sink(s), status every 5 s",
+    const char *want[] = {"backend v4l2, device '/dev/video0', 1280x720, 60 fps, pixel format mjpeg, detector pose, format json, 0 sink(s), status every 5 s, kiosk on 127.0.0.1:8080 with history in kiosk.sqlite",
                           "backend libcamera, device 'auto', 640x480, 90 fps, pixel format auto, detector pose, format nmea, 1 sink(s), status every 10 s",
                           "backend v4l2, device '/dev/video0', 640x480, 120 fps, pixel format mjpeg, detector ball, format json, 3 sink(s), status every 2 s",
                           "backend v4l2, device '/dev/video0', 640x480, 30 fps, pixel format auto, detector ball, format json, 1 sink(s), status every 1 s"};

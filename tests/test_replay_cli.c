@@ -220,7 +220,12 @@ void test_help_version_and_usage_errors(void)
     run_result r;
     run((const char *[]){"--help", NULL}, &r);
     TEST_ASSERT_EQUAL_INT(0, r.code);
-    TEST_ASSERT_NOT_NULL(strstr(r.out, "replay"));
+    /* every command, and each says what it reads */
+    TEST_ASSERT_NOT_NULL(strstr(r.out, "\n  replay "));
+    TEST_ASSERT_NOT_NULL(strstr(r.out, "\n  video "));
+    TEST_ASSERT_NOT_NULL(strstr(r.out, "\n  cam "));
+    TEST_ASSERT_NOT_NULL(strstr(r.out, "find a person (BlazePose"));
+    TEST_ASSERT_NOT_NULL(strstr(r.out, "kiosk"));
     run_free(&r);
 
     run((const char *[]){"replay", "--help", NULL}, &r);

@@ -14,10 +14,15 @@ SUDO=""
 # python3-opencv, python3-venv and opencv-doc for the pose models' converter and its test;
 # clang with its sanitizer/libFuzzer runtime and llvm-symbolizer for tests/fuzz/run.sh;
 # the arm-none-eabi cross compiler with newlib nano and QEMU for the Cortex-M4 firmware check
+# the kiosk (docs/kiosk.md): civetweb for its page, SQLite for the history, nlohmann-json;
+# libmosquitto for the MQTT sink and the mosquitto broker (and its clients) its tests start;
+# chromium and chromedriver for the kiosk's browser test (about 13 s to install here)
 pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev
       python3-opencv python3-venv opencv-doc
       clang libclang-rt-14-dev llvm-14
-      gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm)
+      gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
+      libcivetweb-dev libsqlite3-dev nlohmann-json3-dev libmosquitto-dev mosquitto mosquitto-clients
+      openssl chromium chromium-driver)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <chrono>
 #include <thread>
 #include <vector>
 
@@ -19,6 +20,9 @@
 
 #include "capture.hpp"
 #include "detector.hpp"
+#if defined(GS_HAVE_KIOSK)
+#include "kiosk.hpp"
+#endif
 
 extern "C" {
 #include "gravscale/gravscale.h"
@@ -40,11 +44,13 @@ const char kHelp[] =
     "\n"
     "The device daemon: captures live frames, runs the detector and the core, and\n"
     "writes every event as a line (JSON Lines or NMEA) to the profile's sinks\n"
-    "(stdout, file, serial, TCP server, TCP client, UDP), with a status line every\n"
-    "[status] interval_s. Runs until the source ends or SIGINT/SIGTERM, then\n"
+    "(stdout, file, serial, TCP server, TCP client, UDP, MQTT), with a status line\n"
+    "every [status] interval_s. Runs until the source ends or SIGINT/SIGTERM, then\n"
     "flushes open flights and summaries and drains the sinks. docs/cam.md.\n"
+    "With [kiosk] it also serves the results page, athletes' history and its API\n"
+    "(docs/kiosk.md); then a source that ends leaves the page up until a signal.\n"
     "\n"
-    "  --config FILE          the profile: [cam] [core] [ball] [pose] [sink.*] [status]\n"
+    "  --config FILE          the profile: [cam] [core] [ball] [pose] [sink.*] [status] [kiosk]\n"
     "options override the profile's [cam] keys:\n"
     "  --backend B            v4l2 | libcamera | gstreamer | file | keypoints\n"
     "  --device D             /dev/videoN; a libcamera index or id; a GStreamer\n"
@@ -57,10 +63,14 @@ const char kHelp[] =
     "  --status-interval S    seconds between status lines, 0 none ([status] interval_s)\n"
     "  --as-fast-as-possible  file/keypoints: do not wait for the frames' times\n"
     "  --drain-s S            at the end, wait at most S s for queued lines (default 2)\n"
+    "  --kiosk-port N         the kiosk page's port ([kiosk] port; 0: a free one)\n"
+    "  --kiosk-db FILE        the kiosk's SQLite history ([kiosk] db)\n"
+    "  --wait-for-athlete     file/keypoints: start the video once an athlete is named\n"
     "  --help                 this text\n"
     "\n"
     "A TCP server sink with port = 0 gets a free port, printed on stderr as\n"
-    "\"gravscale: cam: tcp sink listening on ADDRESS:PORT\".\n"
+    "\"gravscale: cam: tcp sink listening on ADDRESS:PORT\"; the kiosk prints\n"
+    "\"gravscale: cam: kiosk page on http://ADDRESS:PORT/\".\n"
     "\n"
     "Exit codes: 0 the source ended or a signal stopped it (events flushed);\n"
     "1 the source failed while running (device gone, bad data; events flushed);\n"
@@ -136,8 +146,9 @@ gs_status cam_config_set(void *ctx, const char *key, size_t kl, const char *v, s
 }
 
 struct Options {
-    std::string config, backend, device, pixel_format, detector;
-    int width = 0, height = 0;
+    std::string config, backend, device, pixel_format, detector, kiosk_db;
+    int width = 0, height = 0, kiosk_port = -1;
+    bool wait_for_athlete = false;
     double fps = 0.0, status_interval_s = -1.0, drain_s = -1.0;
     bool fast = false, out_format_set = false, check = false;
     gs_format out_format = GS_FMT_JSON;
@@ -157,7 +168,7 @@ int parse_args(int argc, char **argv, Options &o)
 {
     static const char *const with_value[] = {"--config",       "--backend", "--device",          "--size",
                                              "--fps",          "--pixel-format", "--detector",   "--output-format",
-                                             "--status-interval", "--drain-s"};
+                                             "--status-interval", "--drain-s", "--kiosk-port", "--kiosk-db"};
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
@@ -170,6 +181,10 @@ int parse_args(int argc, char **argv, Options &o)
         }
         if (a == "--check") {
             o.check = true;
+            continue;
+        }
+        if (a == "--wait-for-athlete") {
+            o.wait_for_athlete = true;
             continue;
         }
         char name_buf[32];
@@ -208,6 +223,13 @@ int parse_args(int argc, char **argv, Options &o)
             if (!gs_format_from_name(val.c_str(), val.size(), &o.out_format))
                 return usage_error("--output-format must be json or nmea, not '" + val + "'");
             o.out_format_set = true;
+        } else if (name == "--kiosk-port") {
+            if (!parse_num(val, 0, 65535, d) || d != std::floor(d))
+                return usage_error("--kiosk-port must be 0 .. 65535, not '" + val + "'");
+            o.kiosk_port = static_cast<int>(d);
+        } else if (name == "--kiosk-db") {
+            if (val.empty()) return usage_error("--kiosk-db needs a file");
+            o.kiosk_db = val;
         } else if (name == "--status-interval") {
             if (!parse_num(val, 0, 3600, d)) return usage_error("--status-interval must be 0 .. 3600 s, not '" + val + "'");
             o.status_interval_s = d;
@@ -224,11 +246,29 @@ int parse_args(int argc, char **argv, Options &o)
 }
 
 
+#if defined(GS_HAVE_KIOSK)
+using KioskConfig = gs::kiosk::Config;
+gs_cfg_section kiosk_section(KioskConfig &k) { return gs::kiosk::config_section(k); }
+gs_status kiosk_check(const KioskConfig &k, gs_cfg_error &e) { return gs::kiosk::config_check(k, e); }
+#else
+struct KioskConfig {
+    bool on() const { return false; }
+};
+gs_status kiosk_refuse(void *, const char *, size_t, const char *, size_t, char *msg, size_t cap)
+{
+    return set_msg(msg, cap, "this gravscale was built without the kiosk (civetweb, SQLite, nlohmann-json: "
+                   "tools/bootstrap.sh installs them)", GS_EINVAL);
+}
+gs_cfg_section kiosk_section(KioskConfig &k) { return gs_cfg_section{"kiosk", kiosk_refuse, &k}; }
+gs_status kiosk_check(const KioskConfig &, gs_cfg_error &) { return GS_OK; }
+#endif
+
 struct Profile {
     gs_core_config core;
     CamConfig cam;
     gs::DetectorConfigs det;
     gs_sinks_config sinks;
+    KioskConfig kiosk;
 };
 
 gs_status parse_profile(const std::string &text, Profile &p, bool small_object, gs_cfg_error &e)
@@ -241,7 +281,9 @@ gs_status parse_profile(const std::string &text, Profile &p, bool small_object, 
     p.cam = CamConfig();
     p.det = gs::DetectorConfigs();
     gs_sinks_config_default(&p.sinks);
-    std::vector<gs_cfg_section> sec = {{"core", gs_core_config_set, &p.core}, {"cam", cam_config_set, &p.cam}};
+    p.kiosk = KioskConfig();
+    std::vector<gs_cfg_section> sec = {{"core", gs_core_config_set, &p.core}, {"cam", cam_config_set, &p.cam},
+                                       kiosk_section(p.kiosk)};
     gs::detector_config_sections(p.det, sec);
     gs_cfg_section sink_sec[GS_SINKS_CONFIG_SECTIONS];
     size_t ns = gs_sinks_config_sections(&p.sinks, sink_sec, GS_SINKS_CONFIG_SECTIONS);
@@ -259,6 +301,8 @@ gs_status parse_profile(const std::string &text, Profile &p, bool small_object, 
     if ((st = gs_core_config_check(&p.core, &e)) != GS_OK) return st;
     std::memset(&e, 0, sizeof e);
     if ((st = gs_sinks_config_check(&p.sinks, &e)) != GS_OK) return st;
+    std::memset(&e, 0, sizeof e);
+    if ((st = kiosk_check(p.kiosk, e)) != GS_OK) return st;
     std::memset(&e, 0, sizeof e);
     if (!gs::detector_config_check(p.det, e)) return GS_EINVAL;
     return GS_OK;
@@ -296,6 +340,29 @@ int load_profile(const Options &o, Profile &p)
     if (o.drain_s >= 0.0) c.drain_s = o.drain_s;
     if (o.status_interval_s >= 0.0) p.sinks.status_interval_s = o.status_interval_s;
     if (o.out_format_set) p.core.format = o.out_format;
+#if defined(GS_HAVE_KIOSK)
+    if (o.kiosk_port >= 0) p.kiosk.port = static_cast<uint16_t>(o.kiosk_port);
+    if (!o.kiosk_db.empty()) p.kiosk.db = o.kiosk_db;
+    if (o.wait_for_athlete) p.kiosk.wait_for_athlete = true;
+#endif
+#if defined(GS_HAVE_KIOSK)
+    if (p.kiosk.on() && p.kiosk.wait_for_athlete && c.cap.backend != "file" && c.cap.backend != "keypoints") {
+        std::fprintf(stderr, "gravscale: %s: [kiosk] wait_for_athlete holds a recorded source (file, keypoints), "
+                     "not %s\n", o.config.c_str(), c.cap.backend.c_str());
+        return EXIT_USAGE;
+    }
+#endif
+    if ((o.kiosk_port >= 0 || !o.kiosk_db.empty() || o.wait_for_athlete) && !p.kiosk.on()) {
+        std::fprintf(stderr, "gravscale: %s: --kiosk-port, --kiosk-db and --wait-for-athlete need a [kiosk] section%s\n",
+                     o.config.c_str(),
+#if defined(GS_HAVE_KIOSK)
+                     ""
+#else
+                     " (and a gravscale built with the kiosk)"
+#endif
+        );
+        return EXIT_USAGE;
+    }
     return EXIT_OK;
 }
 
@@ -381,6 +448,31 @@ private:
 struct Daemon {
     gs_sinkset sinks;
     gs_format fmt = GS_FMT_JSON;
+    bool json_sinks = false;  // NMEA to the sinks, and JSON too for those that take only JSON (MQTT)
+#if defined(GS_HAVE_KIOSK)
+    std::unique_ptr<gs::kiosk::Kiosk> kiosk;  // every event as JSON, trace included
+#endif
+    bool kiosk_on() const
+    {
+#if defined(GS_HAVE_KIOSK)
+        return kiosk != nullptr;
+#else
+        return false;
+#endif
+    }
+    // one line to the sinks (json: its JSON form when the sinks' format is NMEA, or NULL) and the kiosk
+    void write(const char *line, size_t n, const char *json, size_t jn)
+    {
+        if (line && n) gs_sinkset_write_pair(&sinks, line, n, json_sinks ? json : nullptr, jn);
+#if defined(GS_HAVE_KIOSK)
+        if (kiosk) {
+            if (fmt == GS_FMT_JSON && line && n)
+                kiosk->on_line(line, n);
+            else if (json && jn)
+                kiosk->on_line(json, jn);
+        }
+#endif
+    }
     uint64_t jumps = 0, accepted = 0, summaries = 0, emit_fail = 0;
 };
 
@@ -389,7 +481,13 @@ bool is_trace_event(gs_event_type t) { return t == GS_EV_STATE || t == GS_EV_SAM
 void on_event(void *ctx, const gs_event *ev)
 {
     Daemon &d = *static_cast<Daemon *>(ctx);
-    if (is_trace_event(ev->type)) return;
+    if (is_trace_event(ev->type)) {  // never to the sinks; the kiosk draws the track from them
+        if (!d.kiosk_on()) return;
+        char tb[GS_EMIT_MAX];
+        size_t tn = gs_emit(GS_FMT_JSON, ev, tb, sizeof tb);
+        if (tn) d.write(nullptr, 0, tb, tn);
+        return;
+    }
     // a track other than 0 that never had a flight (a distractor) gets no summary
     if (ev->type == GS_EV_SUMMARY && ev->u.height.track != 0 && ev->u.height.n_jumps == 0 &&
         ev->u.height.n_rejected == 0)
@@ -400,13 +498,15 @@ void on_event(void *ctx, const gs_event *ev)
     } else if (ev->type == GS_EV_SUMMARY) {
         d.summaries++;
     }
-    char buf[GS_EMIT_MAX];
+    char buf[GS_EMIT_MAX], jbuf[GS_EMIT_MAX];
     size_t n = gs_emit(d.fmt, ev, buf, sizeof buf);
     if (n == 0) {
         d.emit_fail++;
         return;
     }
-    gs_sinkset_write(&d.sinks, buf, n);
+    size_t jn = 0;
+    if (d.fmt != GS_FMT_JSON && (d.json_sinks || d.kiosk_on())) jn = gs_emit(GS_FMT_JSON, ev, jbuf, sizeof jbuf);
+    d.write(buf, n, jn ? jbuf : nullptr, jn);
 }
 
 // One core pipeline per tracked object.
@@ -427,6 +527,7 @@ public:
                 return nullptr;
             }
             gs_pipeline_set_track(&tp->p, static_cast<uint32_t>(pipes_.size()));
+            if (d_.kiosk_on()) gs_pipeline_set_trace(&tp->p, true);
             pipes_.push_back(std::move(tp));
         }
         return &pipes_[track]->p;
@@ -467,9 +568,29 @@ uint8_t nmea_checksum(const char *body, size_t n)
     return c;
 }
 
+// the JSON status line into line[cap]; its length, 0 if it does not fit
+size_t status_json(const Daemon &d, const Stats &s, double t_s, const char *fps_txt, const char *tsrc, char *line,
+                   size_t cap)
+{
+    static char sinks[8192];
+    if (!gs_sinkset_status_json(&d.sinks, sinks, sizeof sinks)) std::snprintf(sinks, sizeof sinks, "null");
+    const char *fmt = "{\"event\":\"status\",\"t_s\":%.3f,\"state\":\"%s\",\"frames\":%lld,\"fps\":%s,"
+                      "\"dropped\":%llu,\"dropped_seq\":%llu,\"dropped_time\":%llu,\"corrupt\":%llu,"
+                      "\"t_source_s\":%s,\"jumps\":%llu,\"accepted\":%llu,\"sinks\":%s}\n";
+    int n = 0;
+    for (const char *sk : {static_cast<const char *>(sinks), "null"}) {  // many sinks: the line without their details
+        n = std::snprintf(line, cap, fmt, t_s, s.state, static_cast<long long>(s.frames), fps_txt,
+                          static_cast<unsigned long long>(s.dropped), static_cast<unsigned long long>(s.dropped_seq),
+                          static_cast<unsigned long long>(s.dropped_time), static_cast<unsigned long long>(s.corrupt),
+                          tsrc, static_cast<unsigned long long>(d.jumps), static_cast<unsigned long long>(d.accepted), sk);
+        if (n > 0 && static_cast<size_t>(n) < cap) return static_cast<size_t>(n);
+    }
+    return 0;
+}
+
 void write_status(Daemon &d, const Stats &s, double t_s, double fps)
 {
-    char line[GS_SINK_LINE_MAX];
+    char line[GS_SINK_LINE_MAX], json[GS_SINK_LINE_MAX];
     char fps_txt[32], tsrc[32];
     if (std::isfinite(fps))
         std::snprintf(fps_txt, sizeof fps_txt, "%.2f", fps);
@@ -479,33 +600,29 @@ void write_status(Daemon &d, const Stats &s, double t_s, double fps)
         std::snprintf(tsrc, sizeof tsrc, "%.4f", s.t_source_s);
     else
         std::snprintf(tsrc, sizeof tsrc, "null");
-    int n;
+    size_t n = 0, jn = 0;
     if (d.fmt == GS_FMT_NMEA) {
         char body[96];
         int b = std::snprintf(body, sizeof body, "GSSTS,%lld,%s,%llu,%s", static_cast<long long>(s.frames),
                               std::isfinite(fps) && fps < 1e6 ? fps_txt : "", static_cast<unsigned long long>(s.dropped), s.state);
-        n = std::snprintf(line, sizeof line, "$%s*%02X\r\n", body, nmea_checksum(body, static_cast<size_t>(b)));
+        int w = std::snprintf(line, sizeof line, "$%s*%02X\r\n", body, nmea_checksum(body, static_cast<size_t>(b)));
+        n = w > 0 && static_cast<size_t>(w) < sizeof line ? static_cast<size_t>(w) : 0;
+        if (d.json_sinks || d.kiosk_on()) jn = status_json(d, s, t_s, fps_txt, tsrc, json, sizeof json);
     } else {
-        static char sinks[8192];
-        if (!gs_sinkset_status_json(&d.sinks, sinks, sizeof sinks)) std::snprintf(sinks, sizeof sinks, "null");
-        const char *fmt = "{\"event\":\"status\",\"t_s\":%.3f,\"state\":\"%s\",\"frames\":%lld,\"fps\":%s,"
-                          "\"dropped\":%llu,\"dropped_seq\":%llu,\"dropped_time\":%llu,\"corrupt\":%llu,"
-                          "\"t_source_s\":%s,\"jumps\":%llu,\"accepted\":%llu,\"sinks\":%s}\n";
-        n = std::snprintf(line, sizeof line, fmt, t_s, s.state, static_cast<long long>(s.frames), fps_txt,
-                          static_cast<unsigned long long>(s.dropped), static_cast<unsigned long long>(s.dropped_seq),
-                          static_cast<unsigned long long>(s.dropped_time), static_cast<unsigned long long>(s.corrupt),
-                          tsrc, static_cast<unsigned long long>(d.jumps), static_cast<unsigned long long>(d.accepted),
-                          sinks);
-        if (n < 0 || static_cast<size_t>(n) >= sizeof line)  // many sinks: the line without their details
-            n = std::snprintf(line, sizeof line, fmt, t_s, s.state, static_cast<long long>(s.frames), fps_txt,
-                              static_cast<unsigned long long>(s.dropped),
-                              static_cast<unsigned long long>(s.dropped_seq),
-                              static_cast<unsigned long long>(s.dropped_time),
-                              static_cast<unsigned long long>(s.corrupt), tsrc,
-                              static_cast<unsigned long long>(d.jumps), static_cast<unsigned long long>(d.accepted),
-                              "null");
+        n = status_json(d, s, t_s, fps_txt, tsrc, line, sizeof line);
     }
-    if (n > 0 && static_cast<size_t>(n) < sizeof line) gs_sinkset_write(&d.sinks, line, static_cast<size_t>(n));
+    if (n) d.write(line, n, jn ? json : nullptr, jn);
+}
+
+std::string kiosk_text(const KioskConfig &k)
+{
+#if defined(GS_HAVE_KIOSK)
+    if (k.on())
+        return ", kiosk on " + k.bind + ":" + std::to_string(k.port) + " with history in " + k.db +
+               (k.wait_for_athlete ? ", waiting for an athlete" : "");
+#endif
+    (void)k;
+    return "";
 }
 
 // ---- the run -----------------------------------------------------------------------------
@@ -522,11 +639,12 @@ int run(const Options &o)
                                       &prof.sinks.tcp_client_sw, &prof.sinks.udp_sw};
         for (const gs_sink_switch *x : sw) n_sinks += gs_sinks_config_on(x, false);
         n_sinks += gs_sinks_config_on(&prof.sinks.stdout_sw, true);
+        n_sinks += gs_sinks_config_on(&prof.sinks.mqtt_sw, false);
         std::printf("%s: backend %s, device '%s', %dx%d, %g fps, pixel format %s, detector %s, format %s, "
-                    "%zu sink(s), status every %g s\n",
+                    "%zu sink(s), status every %g s%s\n",
                     o.config.c_str(), cc.cap.backend.c_str(), cc.cap.device.c_str(), cc.cap.width, cc.cap.height,
                     cc.cap.fps, cc.cap.pixel_format.c_str(), cc.detector.c_str(), gs_format_name(prof.core.format),
-                    n_sinks, prof.sinks.status_interval_s);
+                    n_sinks, prof.sinks.status_interval_s, kiosk_text(prof.kiosk).c_str());
         return std::fflush(stdout) == 0 ? EXIT_OK : EXIT_IO;
     }
     install_signals();
@@ -568,6 +686,18 @@ int run(const Options &o)
         std::fprintf(stderr, "gravscale: %s: %s\n", o.config.c_str(), serr);
         return EXIT_USAGE;
     }
+    d.json_sinks = d.fmt != GS_FMT_JSON && gs_sinkset_wants_json(&d.sinks);
+#if defined(GS_HAVE_KIOSK)
+    if (prof.kiosk.on()) {
+        d.kiosk = gs::kiosk::Kiosk::start(prof.kiosk, err);
+        if (!d.kiosk) {
+            std::fprintf(stderr, "gravscale: %s: %s\n", o.config.c_str(), err.c_str());
+            gs_sinkset_close(&d.sinks);
+            return EXIT_USAGE;
+        }
+        std::fprintf(stderr, "gravscale: cam: kiosk page on %s\n", d.kiosk->url().c_str());
+    }
+#endif
     for (size_t i = 0; i < d.sinks.n; i++) {
         uint16_t port = gs_sink_tcp_port(&d.sinks.sinks[i]);
         if (port) {
@@ -602,10 +732,26 @@ int run(const Options &o)
     int64_t frames_at_status = 0;
     double t_at_status = t0, last_frame_wall = t0;
     int exit_rc = EXIT_OK;
+    // a recorded source waits until the kiosk's operator names an athlete ([kiosk] wait_for_athlete)
+    auto holding = [&]() {
+#if defined(GS_HAVE_KIOSK)
+        return d.kiosk && d.kiosk->holding();
+#else
+        return false;
+#endif
+    };
+    while (!g_stop && holding()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(kStepMs));
+        gs_sinkset_poll(&d.sinks, gs_sink_now_s());
+    }
+    bool source_ended = false;
     while (!g_stop) {
         gs::ReadResult r = keypoints ? feed.read(kf, kStepMs, err) : cap->read(frame, kStepMs);
         const double now = gs_sink_now_s();
-        if (r == gs::ReadResult::end) break;
+        if (r == gs::ReadResult::end) {
+            source_ended = true;
+            break;
+        }
         if (r == gs::ReadResult::error) {
             std::fprintf(stderr, "gravscale: %s\n", keypoints ? err.c_str() : cap->error().c_str());
             exit_rc = EXIT_SOURCE;
@@ -667,6 +813,20 @@ int run(const Options &o)
         double now = gs_sink_now_s();
         write_status(d, st, now - t0, (st.frames - frames_at_status) / std::max(1e-9, now - t_at_status));
     }
+#if defined(GS_HAVE_KIOSK)
+    if (d.kiosk) {  // the results stay on the page (a recorded clip ends in seconds) until a signal
+        d.kiosk->source_ended();
+        if (source_ended && !g_stop)
+            std::fprintf(stderr, "gravscale: cam: the source ended; the kiosk page stays up until SIGINT/SIGTERM\n");
+        while (source_ended && !g_stop) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(kStepMs));
+            gs_sinkset_poll(&d.sinks, gs_sink_now_s());
+        }
+        if (source_ended && g_stop)
+            std::fprintf(stderr, "gravscale: cam: %s: stopping\n", g_stop == SIGINT ? "SIGINT" : "SIGTERM");
+        d.kiosk.reset();  // civetweb's stop takes about 1 s
+    }
+#endif
     uint64_t left = gs_sinkset_drain(&d.sinks, cc.drain_s);
     bool failed = false;
     for (size_t i = 0; i < d.sinks.n; i++) {

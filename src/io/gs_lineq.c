@@ -117,17 +117,25 @@ uint64_t gs_lineq_reader_pending(const gs_lineq_reader *r, const gs_lineq *q)
 
 void gs_lineq_reader_rewind(gs_lineq_reader *r) { r->cur_off = 0; }
 
+/* the reader's next line in hand (copied out of the ring); false when none waits */
+static bool take_next(gs_lineq_reader *r, const gs_lineq *q)
+{
+    if (r->cur_len > 0)
+        return true;
+    gs_lineq_reader_catch_up(r, q);
+    if (r->next_seq >= q->next_seq)
+        return false;
+    r->cur_len = copy_line(q, r->next_seq, r->cur);
+    r->cur_off = 0;
+    r->next_seq++;
+    return true;
+}
+
 int gs_lineq_pump(gs_lineq_reader *r, const gs_lineq *q, int fd, gs_lineq_write_fn wr)
 {
     for (;;) {
-        if (r->cur_len == 0) {
-            gs_lineq_reader_catch_up(r, q);
-            if (r->next_seq >= q->next_seq)
-                return 0; /* nothing waiting */
-            r->cur_len = copy_line(q, r->next_seq, r->cur);
-            r->cur_off = 0;
-            r->next_seq++;
-        }
+        if (!take_next(r, q))
+            return 0; /* nothing waiting */
         while (r->cur_off < r->cur_len) {
             ssize_t w = wr(fd, r->cur + r->cur_off, r->cur_len - r->cur_off);
             if (w < 0) {
@@ -153,4 +161,20 @@ ssize_t gs_lineq_write_fd(int fd, const void *p, size_t n) { return write(fd, p,
 ssize_t gs_lineq_write_sock(int fd, const void *p, size_t n)
 {
     return send(fd, p, n, MSG_NOSIGNAL | MSG_DONTWAIT);
+}
+
+int gs_lineq_pump_msg(gs_lineq_reader *r, const gs_lineq *q, gs_lineq_send_fn send, void *ctx)
+{
+    while (take_next(r, q)) {
+        int e = send(ctx, r->cur, r->cur_len);
+        if (e == EAGAIN)
+            return 0;
+        if (e)
+            return e;
+        r->sent++;
+        r->bytes += r->cur_len;
+        r->cur_len = 0;
+        r->cur_off = 0;
+    }
+    return 0;
 }

@@ -64,6 +64,12 @@ typedef ssize_t (*gs_lineq_write_fn)(int fd, const void *p, size_t n);
  * hand stays, with its offset). */
 int gs_lineq_pump(gs_lineq_reader *r, const gs_lineq *q, int fd, gs_lineq_write_fn wr);
 
+/* Message sinks (MQTT): send(ctx, line, len) takes one whole line (with its '\n')
+ * and returns 0 when it took it, EAGAIN to stop for now (the line stays in hand) or
+ * another errno (the line stays too). Returns 0 (idle or EAGAIN) or that errno. */
+typedef int (*gs_lineq_send_fn)(void *ctx, const char *line, size_t len);
+int gs_lineq_pump_msg(gs_lineq_reader *r, const gs_lineq *q, gs_lineq_send_fn send, void *ctx);
+
 /* A stream was lost: the line in hand restarts from its first byte on the next
  * connection, so the new peer starts at a line boundary. */
 void gs_lineq_reader_rewind(gs_lineq_reader *r);

@@ -9,7 +9,7 @@
 
 static const char *const k_all[GS_PROFILE_SECTIONS] = {
     "core", "cam", "ball", "pose", "sink.stdout", "sink.file", "sink.serial",
-    "sink.tcp", "sink.tcp_client", "sink.udp", "status"};
+    "sink.tcp", "sink.tcp_client", "sink.udp", "sink.mqtt", "status", "kiosk"};
 
 gs_status gs_profile_skip_key(void *ctx, const char *key, size_t key_len, const char *value,
                               size_t value_len, char *msg, size_t cap)

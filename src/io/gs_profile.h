@@ -8,8 +8,9 @@
 #include "gravscale/gs_config.h"
 
 /* Every section a profile may hold: core, cam, ball, pose, sink.stdout,
- * sink.file, sink.serial, sink.tcp, sink.tcp_client, sink.udp, status. */
-#define GS_PROFILE_SECTIONS 11
+ * sink.file, sink.serial, sink.tcp, sink.tcp_client, sink.udp, sink.mqtt,
+ * status, kiosk. */
+#define GS_PROFILE_SECTIONS 13
 
 /* Fill out with skipping handlers for every profile section not named in
  * own[0..n_own); returns how many (0 if cap is too small). */

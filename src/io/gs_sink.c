@@ -178,13 +178,28 @@ int gs_sinkset_add(gs_sinkset *set, const gs_sink *s)
     return 0;
 }
 
-size_t gs_sinkset_write(gs_sinkset *set, const char *line, size_t len)
+size_t gs_sinkset_write_pair(gs_sinkset *set, const char *line, size_t len, const char *json, size_t json_len)
 {
     size_t dropped = 0;
-    for (size_t i = 0; i < set->n; i++)
-        if (set->sinks[i].write_line(set->sinks[i].state, line, len) != 0)
+    for (size_t i = 0; i < set->n; i++) {
+        bool j = json && set->sinks[i].json_only;
+        if (set->sinks[i].write_line(set->sinks[i].state, j ? json : line, j ? json_len : len) != 0)
             dropped++;
+    }
     return dropped;
+}
+
+size_t gs_sinkset_write(gs_sinkset *set, const char *line, size_t len)
+{
+    return gs_sinkset_write_pair(set, line, len, NULL, 0);
+}
+
+bool gs_sinkset_wants_json(const gs_sinkset *set)
+{
+    for (size_t i = 0; i < set->n; i++)
+        if (set->sinks[i].json_only)
+            return true;
+    return false;
 }
 
 size_t gs_sinkset_write_event(gs_sinkset *set, gs_format fmt, const gs_event *ev)

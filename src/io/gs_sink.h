@@ -61,6 +61,9 @@ typedef struct {
     void (*info)(const void *state, gs_sink_info *out);
     /* Close descriptors and free the state. */
     void (*close)(void *state);
+    /* Takes JSON event lines only (MQTT: one JSON message per event); a daemon
+     * writing NMEA gives such sinks the JSON form (gs_sinkset_write_pair). */
+    bool json_only;
 } gs_sink;
 
 /* ------------------------------------------------------------- sink configs */
@@ -115,6 +118,29 @@ typedef struct {
 
 int gs_sink_udp_open(gs_sink *s, const gs_sink_udp_cfg *cfg, char *err, size_t cap);
 
+/* MQTT (libmosquitto; docs/sinks.md): every JSON event line becomes one message on
+ * <topic_prefix>/<device>/<event> (the daemon's status lines on .../status/daemon),
+ * jump and summary at QoS >= 1; a retained <topic_prefix>/<device>/status is
+ * "online" after each connect and "offline" by the broker's last will or at close. */
+typedef struct {
+    char host[128];
+    uint16_t port;              /* 1883 (8883 with TLS) when 0 */
+    char client_id[128];        /* "gravscale-<device>" when empty */
+    char device[64];            /* the host name when empty */
+    char topic_prefix[128];
+    uint8_t qos;                /* 0..2 for every event; jump and summary at least 1 */
+    uint32_t keepalive_s;
+    bool tls, tls_insecure;     /* tls_insecure: no check of the server's host name */
+    char ca_file[256], ca_path[256], cert_file[256], key_file[256];
+    char username[128], password[128], password_file[256];
+    double backoff_min_s, backoff_max_s;
+    uint32_t queue_lines;       /* lines kept while disconnected; full: the oldest go */
+} gs_sink_mqtt_cfg;
+
+/* false when this build has no libmosquitto (the sink then fails to open) */
+bool gs_sink_mqtt_available(void);
+int gs_sink_mqtt_open(gs_sink *s, const gs_sink_mqtt_cfg *cfg, double now_s, char *err, size_t cap);
+
 /* ------------------------------------------------------------------ fan-out */
 
 #define GS_SINKSET_MAX 8
@@ -129,6 +155,11 @@ void gs_sinkset_init(gs_sinkset *set);
 int gs_sinkset_add(gs_sinkset *set, const gs_sink *s);
 /* The same bytes to every sink; returns how many sinks dropped the line. */
 size_t gs_sinkset_write(gs_sinkset *set, const char *line, size_t len);
+/* line to every sink but those that take JSON only, which get json (line when
+ * json is NULL); returns how many sinks dropped it. */
+size_t gs_sinkset_write_pair(gs_sinkset *set, const char *line, size_t len, const char *json, size_t json_len);
+/* Does any sink of the set take JSON only? */
+bool gs_sinkset_wants_json(const gs_sinkset *set);
 /* Emit an event in fmt and write it (events without a form in fmt are skipped). */
 size_t gs_sinkset_write_event(gs_sinkset *set, gs_format fmt, const gs_event *ev);
 void gs_sinkset_poll(gs_sinkset *set, double now_s);

@@ -25,6 +25,12 @@ void gs_sinks_config_default(gs_sinks_config *c)
     c->tcp_client.backoff_min_s = 0.5;
     c->tcp_client.backoff_max_s = 30.0;
     c->tcp_client.queue_lines = 256;
+    c->mqtt_sw = off;
+    snprintf(c->mqtt.topic_prefix, sizeof c->mqtt.topic_prefix, "gravscale");
+    c->mqtt.keepalive_s = 30;
+    c->mqtt.backoff_min_s = 0.5;
+    c->mqtt.backoff_max_s = 30.0;
+    c->mqtt.queue_lines = 256;
     c->status_interval_s = 1.0;
 }
 
@@ -223,6 +229,86 @@ static gs_status h_udp(void *ctx, const char *k, size_t kn, const char *v, size_
     return GS_ENOKEY;
 }
 
+/* a topic level or prefix: no wildcards; a level has no separator either */
+static gs_status set_topic(char *dst, size_t cap, const char *v, size_t n, bool level, char *msg, size_t mcap)
+{
+    for (size_t i = 0; i < n; i++) {
+        unsigned char ch = (unsigned char)v[i];
+        if (ch == '+' || ch == '#' || ch < 0x20 || (level && ch == '/')) {
+            snprintf(msg, mcap, level ? "no '/', '+', '#' or control characters in a topic level"
+                                      : "no '+', '#' or control characters in a topic prefix");
+            return GS_EINVAL;
+        }
+    }
+    if (!level && n && (v[0] == '/' || v[n - 1] == '/')) {
+        snprintf(msg, mcap, "a topic prefix neither starts nor ends with '/'");
+        return GS_EINVAL;
+    }
+    return set_text(dst, cap, v, n, msg, mcap);
+}
+
+static gs_status set_bool(bool *dst, const char *v, size_t n, char *msg, size_t mcap)
+{
+    gs_sink_switch sw = {true, -1};
+    gs_status st = set_enabled(&sw, v, n, msg, mcap);
+    if (st == GS_OK)
+        *dst = sw.enabled == 1;
+    return st;
+}
+
+static gs_status h_mqtt(void *ctx, const char *k, size_t kn, const char *v, size_t vn, char *msg, size_t cap)
+{
+    gs_sinks_config *c = ctx;
+    gs_sink_mqtt_cfg *m = &c->mqtt;
+    c->mqtt_sw.present = true;
+    if (is(k, kn, "enabled"))
+        return set_enabled(&c->mqtt_sw, v, vn, msg, cap);
+    if (is(k, kn, "host"))
+        return set_text(m->host, sizeof m->host, v, vn, msg, cap);
+    if (is(k, kn, "port"))
+        return set_port(&m->port, v, vn, 1, msg, cap);
+    if (is(k, kn, "client_id"))
+        return set_text(m->client_id, sizeof m->client_id, v, vn, msg, cap);
+    if (is(k, kn, "device"))
+        return set_topic(m->device, sizeof m->device, v, vn, true, msg, cap);
+    if (is(k, kn, "topic_prefix"))
+        return set_topic(m->topic_prefix, sizeof m->topic_prefix, v, vn, false, msg, cap);
+    if (is(k, kn, "qos")) {
+        uint32_t q;
+        gs_status st = set_u32(&q, v, vn, 0, 2, msg, cap);
+        if (st == GS_OK)
+            m->qos = (uint8_t)q;
+        return st;
+    }
+    if (is(k, kn, "keepalive_s"))
+        return set_u32(&m->keepalive_s, v, vn, 5, 3600, msg, cap);
+    if (is(k, kn, "tls"))
+        return set_bool(&m->tls, v, vn, msg, cap);
+    if (is(k, kn, "tls_insecure"))
+        return set_bool(&m->tls_insecure, v, vn, msg, cap);
+    if (is(k, kn, "ca_file"))
+        return set_text(m->ca_file, sizeof m->ca_file, v, vn, msg, cap);
+    if (is(k, kn, "ca_path"))
+        return set_text(m->ca_path, sizeof m->ca_path, v, vn, msg, cap);
+    if (is(k, kn, "cert_file"))
+        return set_text(m->cert_file, sizeof m->cert_file, v, vn, msg, cap);
+    if (is(k, kn, "key_file"))
+        return set_text(m->key_file, sizeof m->key_file, v, vn, msg, cap);
+    if (is(k, kn, "username"))
+        return set_text(m->username, sizeof m->username, v, vn, msg, cap);
+    if (is(k, kn, "password"))
+        return set_text(m->password, sizeof m->password, v, vn, msg, cap);
+    if (is(k, kn, "password_file"))
+        return set_text(m->password_file, sizeof m->password_file, v, vn, msg, cap);
+    if (is(k, kn, "backoff_min_s"))
+        return set_secs(&m->backoff_min_s, v, vn, 0.01, 60.0, msg, cap);
+    if (is(k, kn, "backoff_max_s"))
+        return set_secs(&m->backoff_max_s, v, vn, 0.01, 3600.0, msg, cap);
+    if (is(k, kn, "queue_lines"))
+        return set_u32(&m->queue_lines, v, vn, 1, QUEUE_MAX, msg, cap);
+    return GS_ENOKEY;
+}
+
 static gs_status h_status(void *ctx, const char *k, size_t kn, const char *v, size_t vn, char *msg, size_t cap)
 {
     gs_sinks_config *c = ctx;
@@ -241,7 +327,8 @@ size_t gs_sinks_config_sections(gs_sinks_config *c, gs_cfg_section *out, size_t 
     out[3] = (gs_cfg_section){"sink.tcp", h_tcp, c};
     out[4] = (gs_cfg_section){"sink.tcp_client", h_tcp_client, c};
     out[5] = (gs_cfg_section){"sink.udp", h_udp, c};
-    out[6] = (gs_cfg_section){"status", h_status, c};
+    out[6] = (gs_cfg_section){"sink.mqtt", h_mqtt, c};
+    out[7] = (gs_cfg_section){"status", h_status, c};
     return GS_SINKS_CONFIG_SECTIONS;
 }
 
@@ -281,6 +368,26 @@ gs_status gs_sinks_config_check(const gs_sinks_config *c, gs_cfg_error *err)
         if (!c->udp.port)
             return missing(err, "sink.udp", "port", "an enabled UDP sink needs a port");
     }
+    if (gs_sinks_config_on(&c->mqtt_sw, false)) {
+        const gs_sink_mqtt_cfg *m = &c->mqtt;
+        if (!m->host[0])
+            return missing(err, "sink.mqtt", "host", "an enabled MQTT sink needs a host");
+        if (m->backoff_min_s > m->backoff_max_s) {
+            missing(err, "sink.mqtt", "backoff_max_s", "backoff_max_s below backoff_min_s");
+            return GS_ERANGE;
+        }
+        if (m->tls && !m->ca_file[0] && !m->ca_path[0])
+            return missing(err, "sink.mqtt", "ca_file", "tls = yes needs ca_file or ca_path (the broker's CA)");
+        if (!m->tls && (m->ca_file[0] || m->ca_path[0] || m->cert_file[0] || m->key_file[0] || m->tls_insecure))
+            return missing(err, "sink.mqtt", "tls", "TLS keys are set but tls is not yes");
+        if (!m->cert_file[0] != !m->key_file[0])
+            return missing(err, "sink.mqtt", m->cert_file[0] ? "key_file" : "cert_file",
+                           "a client certificate needs both cert_file and key_file");
+        if (m->password[0] && m->password_file[0])
+            return missing(err, "sink.mqtt", "password_file", "password and password_file are both set");
+        if ((m->password[0] || m->password_file[0]) && !m->username[0])
+            return missing(err, "sink.mqtt", "username", "a password needs a username");
+    }
     memset(err, 0, sizeof *err);
     return GS_OK;
 }
@@ -304,6 +411,8 @@ int gs_sinkset_open_config(gs_sinkset *set, const gs_sinks_config *c, double now
         rc = gs_sink_tcp_client_open(&s, &c->tcp_client, now_s, err, cap) || gs_sinkset_add(set, &s);
     if (rc == 0 && gs_sinks_config_on(&c->udp_sw, false))
         rc = gs_sink_udp_open(&s, &c->udp, err, cap) || gs_sinkset_add(set, &s);
+    if (rc == 0 && gs_sinks_config_on(&c->mqtt_sw, false))
+        rc = gs_sink_mqtt_open(&s, &c->mqtt, now_s, err, cap) || gs_sinkset_add(set, &s);
     if (rc != 0) {
         gs_sinkset_close(set);
         return -1;

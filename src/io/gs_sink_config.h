@@ -25,19 +25,22 @@ typedef struct {
     gs_sink_tcp_client_cfg tcp_client;
     gs_sink_switch udp_sw;
     gs_sink_udp_cfg udp;
+    gs_sink_switch mqtt_sw;
+    gs_sink_mqtt_cfg mqtt;
     double status_interval_s; /* [status] interval_s; 0 = no status lines */
 } gs_sinks_config;
 
 void gs_sinks_config_default(gs_sinks_config *c);
 
 /* Fill out[0..) with the sections sink.stdout, sink.file, sink.serial, sink.tcp,
- * sink.tcp_client, sink.udp and status bound to c; returns how many (7), 0 if
- * cap is smaller. Append them to the caller's table for gs_cfg_parse. */
-#define GS_SINKS_CONFIG_SECTIONS 7
+ * sink.tcp_client, sink.udp, sink.mqtt and status bound to c; returns how many
+ * (8), 0 if cap is smaller. Append them to the caller's table for gs_cfg_parse. */
+#define GS_SINKS_CONFIG_SECTIONS 8
 size_t gs_sinks_config_sections(gs_sinks_config *c, gs_cfg_section *out, size_t cap);
 
 /* After parsing: every enabled sink has what it needs (a device, a host and a
- * port), backoff_min_s <= backoff_max_s. Line 0, section and key named. */
+ * port), backoff_min_s <= backoff_max_s, MQTT's TLS and credential keys go
+ * together. Line 0, section and key named. */
 gs_status gs_sinks_config_check(const gs_sinks_config *c, gs_cfg_error *err);
 
 /* Is each sink on after parsing? */

@@ -4,7 +4,8 @@
  * gs_sinks_config_check. Properties: no crash, no read past the text; error
  * records NUL-terminated and explained; after an accepted text every field is
  * in its documented range and every string NUL-terminated inside its array;
- * a check failure names section and key; the sink status line built from the
+ * a check failure names section and key; MQTT topic levels carry no wildcard
+ * and the device no separator; the sink status line built from the
  * configured names (through a /dev/null descriptor sink) is valid JSON.
  * Nothing is opened on the network. Built by tests/fuzz/run.sh (clang). */
 #include "gs_sink_config.h"
@@ -80,6 +81,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     check_switch(&sc.tcp_sw);
     check_switch(&sc.tcp_client_sw);
     check_switch(&sc.udp_sw);
+    check_switch(&sc.mqtt_sw);
+    const gs_sink_mqtt_cfg *m = &sc.mqtt;
+    FZ_CHECK(terminated(m->host, sizeof m->host) && terminated(m->client_id, sizeof m->client_id) &&
+             terminated(m->device, sizeof m->device) && terminated(m->topic_prefix, sizeof m->topic_prefix) &&
+             terminated(m->ca_file, sizeof m->ca_file) && terminated(m->ca_path, sizeof m->ca_path) &&
+             terminated(m->cert_file, sizeof m->cert_file) && terminated(m->key_file, sizeof m->key_file) &&
+             terminated(m->username, sizeof m->username) && terminated(m->password, sizeof m->password) &&
+             terminated(m->password_file, sizeof m->password_file));
+    FZ_CHECK(m->qos <= 2 && m->keepalive_s >= 5 && m->keepalive_s <= 3600);
+    FZ_CHECK(m->queue_lines >= 1 && m->queue_lines <= 65536);
+    FZ_CHECK(m->backoff_min_s >= 0.01 && m->backoff_max_s <= 3600.0);
+    /* topics: no wildcard anywhere, no separator in the device level */
+    FZ_CHECK(!strpbrk(m->topic_prefix, "+#") && !strpbrk(m->device, "/+#"));
+    FZ_CHECK(m->topic_prefix[0] != '/' && (!m->topic_prefix[0] || m->topic_prefix[strlen(m->topic_prefix) - 1] != '/'));
     FZ_CHECK(terminated(sc.file_path, sizeof sc.file_path));
     FZ_CHECK(terminated(sc.serial.device, sizeof sc.serial.device));
     FZ_CHECK(terminated(sc.tcp.bind, sizeof sc.tcp.bind));
@@ -110,11 +125,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FZ_CHECK(sc.tcp_client.host[0] && sc.tcp_client.port &&
                      sc.tcp_client.backoff_min_s <= sc.tcp_client.backoff_max_s);
         if (gs_sinks_config_on(&sc.udp_sw, false)) FZ_CHECK(sc.udp.host[0] && sc.udp.port);
+        if (gs_sinks_config_on(&sc.mqtt_sw, false))
+            FZ_CHECK(m->host[0] && m->backoff_min_s <= m->backoff_max_s && (!m->tls || m->ca_file[0] || m->ca_path[0]) &&
+                     !m->cert_file[0] == !m->key_file[0] && !(m->password[0] && m->password_file[0]) &&
+                     (m->username[0] || (!m->password[0] && !m->password_file[0])));
     }
     /* names from the profile end up in status lines */
     if (sc.file_path[0]) check_status_json(sc.file_path);
     if (sc.serial.device[0]) check_status_json(sc.serial.device);
     if (sc.tcp_client.host[0]) check_status_json(sc.tcp_client.host);
+    if (m->host[0]) check_status_json(m->host);
     free(s);
     return 0;
 }
