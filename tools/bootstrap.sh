@@ -12,10 +12,11 @@ SUDO=""
 
 # OpenCV and libavformat for the video command (tests render clips with them);
 # python3-opencv, python3-venv and opencv-doc for the pose models' converter and its test;
+# Eigen for the ball detector's ballistic fits (and the tests' batch references);
 # clang with its sanitizer/libFuzzer runtime and llvm-symbolizer for tests/fuzz/run.sh;
 # the arm-none-eabi cross compiler with newlib nano and QEMU for the Cortex-M4 firmware check
 pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev
-      python3-opencv python3-venv opencv-doc
+      python3-opencv python3-venv opencv-doc libeigen3-dev
       clang libclang-rt-14-dev llvm-14
       gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm)
 missing=()

@@ -26,7 +26,8 @@ typedef enum {
     GS_REJ_NO_SIZE,         /* "no_size": no standing pixel size known around the flight */
     GS_REJ_UNCERTAIN_A,     /* "uncertain_acceleration": relative SE of a too large */
     GS_REJ_GAP,             /* "gap": frames missing inside the flight */
-    GS_REJ_OTHER_MOTION     /* "other_motion": from the front end: something else moved beside the body through much of the flight */
+    GS_REJ_OTHER_MOTION,    /* "other_motion": from the front end: something else moved beside the body through much of the flight */
+    GS_REJ_NOT_PLANAR       /* "not_planar": from the front end: the acceleration changes along the flight (camera tilted toward the fall, motion in depth) */
 } gs_reject_reason;
 
 /* warning bits of a jump */

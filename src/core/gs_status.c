@@ -32,6 +32,7 @@ const char *gs_reject_reason_name(gs_reject_reason r)
     case GS_REJ_UNCERTAIN_A: return "uncertain_acceleration";
     case GS_REJ_GAP: return "gap";
     case GS_REJ_OTHER_MOTION: return "other_motion";
+    case GS_REJ_NOT_PLANAR: return "not_planar";
     }
     return "unknown";
 }
