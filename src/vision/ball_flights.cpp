@@ -165,7 +165,9 @@ FlightSize BallFlights::measure(const std::vector<BallObs> &pts, const Parabola 
         std::vector<double> dev;
         for (double x : psf_seen_) dev.push_back(std::fabs(x - v));
         double spread = 1.4826 * median_of(dev);
-        v = std::min(std::max(v, 0.0), 25.0);
+        // never below the configured blur: the matte's floor clips the blur's tails,
+        // which makes this estimate low where the blur is small
+        v = std::min(std::max(v, opt_.psf_sigma_px * opt_.psf_sigma_px), 25.0);
         psf_sigma = std::sqrt(v);
         psf_unc = std::max(0.25, 2.0 * spread / std::sqrt((double)psf_seen_.size()));
     }
