@@ -23,6 +23,12 @@
 // then optics blur, Gaussian noise, 8 bits and MJPG (OpenCV's own AVI writer at
 // the given quality).
 //
+// --vup-m-s tosses the ball up at release (the apex mid-flight); --pixel-aspect
+// stores non-square pixels (rendered square, resampled to --width: the truth's
+// x positions and diameters stay in square pixels); --sat 0 with --albedo gives a
+// white, grey or black ball; --restitution 0 a single drop; --pitch-deg a
+// camera tilted toward the fall.
+//
 // Writes CLIP.avi, CLIP.json (parameters and per-flight truth) and
 // CLIP.frames.csv (per-frame truth). Exit 0 ok, 2 usage error, 3 write error.
 #include <algorithm>
@@ -58,6 +64,8 @@ struct Params {
     double x_m = 0.0;             // ball's lateral position at release (right +)
     double drop_m = 1.3;          // ball's bottom above the floor at release
     double vx_m_s = 0.0, vz_m_s = 0.0;  // lateral and depth velocity at release
+    double vup_m_s = 0.0;         // upward velocity at release (a toss)
+    double pixel_aspect = 1.0;    // a stored pixel's width / height (the frame is rendered square, then resampled)
     double release_s = 0.4;
     int drag = 1;
     double cd = 0.55, rho_kg_m3 = 1.2, mass_kg = 0.058, diam_m = 0.067, restitution = 0.72;
@@ -99,6 +107,8 @@ const Key kKeys[] = {
     {"drop-m", &Params::drop_m, nullptr, 0.05, 10},
     {"vx-m-s", &Params::vx_m_s, nullptr, -20, 20},
     {"vz-m-s", &Params::vz_m_s, nullptr, -20, 20},
+    {"vup-m-s", &Params::vup_m_s, nullptr, -20, 20},
+    {"pixel-aspect", &Params::pixel_aspect, nullptr, 0.5, 2},
     {"release-s", &Params::release_s, nullptr, 0, 60},
     {"drag", nullptr, &Params::drag, 0, 1},
     {"cd", &Params::cd, nullptr, 0, 5},
@@ -302,7 +312,7 @@ Trajectory simulate(const Params &p, double t_end)
         double t = i * tr.dt;
         tr.pos.push_back(s.p);
         if (t + 0.5 * tr.dt < p.release_s) continue;        // held still
-        if (t < p.release_s + tr.dt && s.v.x == 0 && s.v.y == 0 && !resting) s.v = {p.vx_m_s, 0, p.vz_m_s};
+        if (t < p.release_s + tr.dt && s.v.x == 0 && s.v.y == 0 && !resting) s.v = {p.vx_m_s, p.vup_m_s, p.vz_m_s};
         if (resting) {  // rolling on the floor, slowing down
             s.v.x *= 1.0 - 0.5 * tr.dt;
             s.v.z *= 1.0 - 0.5 * tr.dt;
@@ -680,8 +690,13 @@ double fit_acc(const std::vector<double> &t, const std::vector<double> &y)
     return 2.0 * sol[2];
 }
 
-int render(const Params &p, const std::string &out)
+int render(const Params &p_stored, const std::string &out)
 {
+    // non-square pixels: the scene is rendered with square ones, p.width of them,
+    // and every frame resampled to the stored width
+    Params p = p_stored;
+    const int out_w = p_stored.width;
+    p.width = static_cast<int>(std::lround(p_stored.width * p_stored.pixel_aspect));
     std::string base = out;
     if (base.size() > 4 && base.compare(base.size() - 4, 4, ".avi") == 0) base.resize(base.size() - 4);
     std::mt19937_64 rng(p.seed);
@@ -710,7 +725,7 @@ int render(const Params &p, const std::string &out)
 
     cv::VideoWriter wr;
     int fourcc = cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
-    if (!wr.open(out, cv::CAP_OPENCV_MJPEG, fourcc, p.fps, cv::Size(p.width, p.height), true)) {
+    if (!wr.open(out, cv::CAP_OPENCV_MJPEG, fourcc, p.fps, cv::Size(out_w, p.height), true)) {
         std::fprintf(stderr, "render_ball: %s: cannot open for writing\n", out.c_str());
         return 3;
     }
@@ -805,6 +820,7 @@ int render(const Params &p, const std::string &out)
             img += noise;
         }
         img.convertTo(u8, CV_8UC3);
+        if (out_w != p.width) cv::resize(u8, u8, cv::Size(out_w, p.height), 0, 0, cv::INTER_AREA);
         wr.write(u8);
         if (fi == p.preview_frame) {
             std::vector<uchar> jpg;  // as the MJPG stream stores it
@@ -855,7 +871,8 @@ int render(const Params &p, const std::string &out)
     }
     std::fprintf(fj, "{\n  \"clip\": \"%s\",\n", out.substr(out.find_last_of('/') + 1).c_str());
     std::fprintf(fj, "  \"diameter_m\": %s,\n", jnum(p.diam_m).c_str());
-    std::fprintf(fj, "  \"width\": %d, \"height\": %d, \"fps\": %s, \"frames\": %d,\n", p.width, p.height,
+    std::fprintf(fj, "  \"pixel_aspect\": %s, \"vup_m_s\": %s,\n", jnum(p.pixel_aspect).c_str(), jnum(p.vup_m_s).c_str());
+    std::fprintf(fj, "  \"width\": %d, \"height\": %d, \"fps\": %s, \"frames\": %d,\n", out_w, p.height,
                  jnum(p.fps).c_str(), nframes);
     std::fprintf(fj, "  \"exposure_s\": %s, \"exposure_frac\": %s,\n", jnum(expo).c_str(), jnum(p.exposure_frac).c_str());
     std::fprintf(fj, "  \"camera\": {\"f_px\": %s, \"hfov_deg\": %s, \"cx\": %s, \"cy\": %s, \"height_m\": %s, \"pitch_deg\": %s},\n",

@@ -27,6 +27,7 @@ typedef enum {
     GS_REJ_UNCERTAIN_A,     /* "uncertain_acceleration": relative SE of a too large */
     GS_REJ_GAP,             /* "gap": frames missing inside the flight */
     GS_REJ_OTHER_MOTION,    /* "other_motion": from the front end: something else moved beside the body through much of the flight */
+    GS_REJ_NOT_PLANAR,      /* "not_planar": from the front end: the acceleration changes along the flight (camera tilted toward the fall, motion in depth) */
     GS_REJ_GRAVITY_DIR,     /* "gravity_direction": the fitted gravity disagrees with the standing body's axis or earlier flights beyond its standard error */
     GS_REJ_FALL,            /* "fall": landed on a floor lower than it left (a step off a box): a free fall, not a jump */
     GS_REJ_NO_FEET_FLIGHT   /* "no_feet_flight": the feet, seen throughout, did not leave the floor together and land around the COM's flight */

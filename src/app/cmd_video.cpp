@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 
 #if __has_include("ball_detector.hpp")
 #include "ball_detector.hpp"
+#include "ball_flights.hpp"
 #define GS_HAVE_BALL_DETECTOR 1
 #else
 #define GS_HAVE_BALL_DETECTOR 0
@@ -222,6 +224,8 @@ struct App {
     uint32_t emit_fail = 0;
     gs::RunRecord rec;
     gs::SceneWatch *watch = nullptr;  // pose: per-flight warnings from the frames
+    gs::BallFlights *flights = nullptr;    // ball: sizes along gravity, geometry, flights the core cannot seed
+    std::map<uint32_t, uint32_t> flight_index;  // ball: per track, the next flight's number
 };
 
 bool is_trace_event(gs_event_type t) { return t == GS_EV_STATE || t == GS_EV_SAMPLE || t == GS_EV_FIT; }
@@ -278,6 +282,12 @@ void on_event(void *ctx, const gs_event *ev)
         j.warnings |= a.watch->flight_warnings(tk_s, tl_s, gs_time_s_of_us(j.t_apex_us));
         ev = &marked;
     }
+    if (ev->type == GS_EV_JUMP && a.flights) {
+        // the core's flights and the front end's (drops) in one count per track
+        marked = *ev;
+        marked.u.jump.index = a.flight_index[marked.u.jump.track]++;
+        ev = &marked;
+    }
     // a track other than 0 that never had a flight (a distractor followed for a
     // moment) gets no summary; track 0 always does, with a null size if need be
     if (ev->type == GS_EV_SUMMARY && ev->u.height.track != 0 && ev->u.height.n_jumps == 0 &&
@@ -304,6 +314,10 @@ void on_event(void *ctx, const gs_event *ev)
 void judge_jump(void *ctx, gs_ev_jump *j)
 {
     App &a = *static_cast<App *>(ctx);
+    if (a.flights) {  // a ball: its size along gravity and the flight's geometry
+        a.flights->judge(j);
+        return;
+    }
     if (!a.watch || !j->accepted) return;
     if (a.watch->other_rejects(gs_time_s_of_us(j->t_takeoff_us), gs_time_s_of_us(j->t_land_us),
                                gs_time_s_of_us(j->t_apex_us))) {
@@ -345,6 +359,29 @@ public:
     {
         if (pipes_.empty()) get(0);  // nothing seen: a summary for track 0 with a null size
         for (auto &tp : pipes_) gs_pipeline_flush(&tp->p);
+    }
+    // A flight the front end found (the core could not seed it) into the track's
+    // output and aggregate, as the core reports its own.
+    bool report(const gs_ev_jump &j)
+    {
+        gs_pipeline *p = get(j.track);
+        if (!p) return false;
+        gs_event ev;
+        std::memset(&ev, 0, sizeof ev);
+        ev.type = GS_EV_JUMP;
+        ev.u.jump = j;
+        on_event(&app_, &ev);
+        if (!j.accepted) {
+            gs_agg_reject(&p->agg);
+            return true;
+        }
+        gs_agg_add(&p->agg, j.height_m, j.height_se_m);
+        std::memset(&ev, 0, sizeof ev);
+        ev.type = GS_EV_HEIGHT;
+        gs_agg_get(&p->agg, &ev.u.height);
+        ev.u.height.track = j.track;
+        on_event(&app_, &ev);
+        return true;
     }
     gs_status init_error() const { return init_error_; }
     uint64_t refused = 0;
@@ -588,7 +625,25 @@ int run(const Options &o)
 
     Pipelines pipes(cfg, layout, app);
     std::unique_ptr<gs::BallDetector> det;
-    if (!person) det.reset(new gs::BallDetector(ball_cfg));
+    std::unique_ptr<gs::BallFlights> flights;
+    // the pixels' shape: a stated aspect ratio other than 1 makes them square here
+    // (x scaled); without one (or 1:1, often a default) the ball's shape decides
+    const double sar = src->sample_aspect() > 0.0 && std::fabs(src->sample_aspect() - 1.0) > 1e-3
+                           ? src->sample_aspect() : 1.0;
+    std::vector<gs_ev_jump> fe_jumps;
+    if (!person) {
+        det.reset(new gs::BallDetector(ball_cfg));
+        det->set_backlog(true);  // a ball's flight from its first frame, once it is known to be one
+        gs::BallFlightsOptions bo;
+        bo.core = cfg;
+        bo.g_m_s2 = gs_core_config_g(&cfg);
+        bo.psf_sigma_px = ball_cfg.psf_sigma_px;
+        bo.square_pixels = sar != 1.0;
+        bo.frame_w = src->size().width * sar;
+        bo.frame_h = src->size().height;
+        flights.reset(new gs::BallFlights(bo));
+        app.flights = flights.get();
+    }
     std::vector<gs::BallObs> obs;
     gs::Frame f;
     const bool keep = !o.overlay.empty() || !o.plot.empty();
@@ -684,19 +739,30 @@ int run(const Options &o)
             obs.clear();
             det->process(f.bgr, f.t_s, obs);
             for (const gs::BallObs &b : obs) {
-                if (b.track < 0) continue;
-                if (keep) app.rec.frame_obs.back().push_back({b.track, b.x_px, b.y_px, b.diameter_px, b.confidence});
+                if (b.track < 0 || b.frame < 0 || b.frame >= static_cast<int64_t>(app.rec.frame_obs.size())) continue;
+                if (keep)
+                    app.rec.frame_obs[static_cast<size_t>(b.frame)].push_back(
+                        {b.track, b.x_px, b.y_px, b.diameter_px, b.confidence});
                 gs_pipeline *p = pipes.get(static_cast<uint32_t>(b.track));
                 if (!p) {
                     std::fprintf(stderr, "gravscale: cannot start the pipeline: %s\n",
                                  gs_status_str(pipes.init_error()));
                     return EXIT_USAGE;
                 }
-                gs_status st = gs_pipeline_push_point(p, f.t_s, static_cast<float>(b.x_px),
+                gs::BallObs sq = b;  // in square pixels
+                sq.x_px *= sar;
+                sq.sxx *= sar * sar;
+                sq.sxy *= sar;
+                flights->add(sq);
+                gs_status st = gs_pipeline_push_point(p, b.t_s, static_cast<float>(sq.x_px),
                                                       static_cast<float>(b.y_px), static_cast<float>(b.confidence),
                                                       static_cast<float>(b.diameter_px));
                 if (st != GS_OK && pipes.refused++ == 0) pipes.first_refusal = st;
             }
+            flights->set_rolling_shutter(det->rolling_shutter_s_per_row());
+            fe_jumps.clear();
+            flights->take_pending(f.t_s, false, fe_jumps);
+            for (const gs_ev_jump &j : fe_jumps) pipes.report(j);
         }
         if (progress && (f.index & 15) == 0 && now_s() > next_progress) {
             next_progress = now_s() + 0.25;
@@ -729,6 +795,11 @@ int run(const Options &o)
     if (!src->is_image_sequence() && announced > 0 && src->frames_read() + 2 < announced)
         std::fprintf(stderr, "gravscale: %s: warning: decoding ended after %lld of the %lld frames the container announces\n",
                      o.input.c_str(), static_cast<long long>(src->frames_read()), static_cast<long long>(announced));
+    if (flights) {
+        fe_jumps.clear();
+        flights->take_pending(0.0, true, fe_jumps);
+        for (const gs_ev_jump &j : fe_jumps) pipes.report(j);
+    }
     pipes.flush_all();
     if (pipes.refused)
         std::fprintf(stderr, "gravscale: %llu observations refused by the pipeline (first: %s)\n",

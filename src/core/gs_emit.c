@@ -145,7 +145,7 @@ enum {
     V_WARNINGS, /* JSON: uint32_t GS_WARN_* bits as an array of names */
     V_CI95,     /* JSON: the gs_reals mid, lo, hi from here as [lo,hi] or null */
     V_FLAG,     /* NMEA: bool as the character a (true) or b (false) */
-    V_DIGIT,    /* NMEA: a gs_reject_reason as one digit */
+    V_DIGIT,    /* NMEA: a gs_reject_reason as one character, 0-9 then A-Z */
     V_INITIAL,  /* NMEA: a string's first letter in upper case */
     V_HEX8,     /* NMEA: the low byte of a uint32_t in two hex digits */
     V_TEXT      /* NMEA: a string of at most a characters, NULL: this build's version */
@@ -215,6 +215,7 @@ static void w_nmea_value(gs_w *w, const void *base, const field *f)
         gs_reject_reason r;
         memcpy(&r, p, sizeof r);
         if ((uint32_t)r <= 9u) c[n++] = (char)('0' + (int)r);
+        else if ((uint32_t)r <= 35u) c[n++] = (char)('A' + (int)r - 10);  /* one character: 10 is A */
         break;
     }
     case V_INITIAL: { /* A absence, N new_body, E end_of_stream */

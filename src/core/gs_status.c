@@ -32,6 +32,7 @@ const char *gs_reject_reason_name(gs_reject_reason r)
     case GS_REJ_UNCERTAIN_A: return "uncertain_acceleration";
     case GS_REJ_GAP: return "gap";
     case GS_REJ_OTHER_MOTION: return "other_motion";
+    case GS_REJ_NOT_PLANAR: return "not_planar";
     case GS_REJ_GRAVITY_DIR: return "gravity_direction";
     case GS_REJ_FALL: return "fall";
     case GS_REJ_NO_FEET_FLIGHT: return "no_feet_flight";

@@ -12,6 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "ballistic.hpp"
+
 namespace gs {
 
 namespace {
@@ -92,8 +94,10 @@ gs_status ball_config_set(void *ctx, const char *key, size_t key_len, const char
         return num_in(value, value_len, 0.0, 1.0, &c->val_min, msg, cap);
     if (key_is(key, key_len, "min_diameter_px"))
         return num_in(value, value_len, 2.0, 2000.0, &c->min_diameter_px, msg, cap);
-    if (key_is(key, key_len, "max_diameter_px"))
+    if (key_is(key, key_len, "max_diameter_px")) {
+        if (value_len == 4 && std::memcmp(value, "auto", 4) == 0) { c->max_diameter_px = 0.0; return GS_OK; }
         return num_in(value, value_len, 2.0, 2000.0, &c->max_diameter_px, msg, cap);
+    }
     if (key_is(key, key_len, "motion_min"))
         return num_in(value, value_len, 1.0, 255.0, &c->motion_min, msg, cap);
     if (key_is(key, key_len, "max_blur_ratio"))
@@ -147,7 +151,7 @@ gs_status ball_config_check(const BallConfig &c, char *msg, size_t cap)
         put_msg(msg, cap, "color = fixed needs hue_deg");
         return GS_EINVAL;
     }
-    if (!(c.min_diameter_px < c.max_diameter_px)) {
+    if (c.max_diameter_px > 0.0 && !(c.min_diameter_px < c.max_diameter_px)) {
         put_msg(msg, cap, "min_diameter_px must be below max_diameter_px");
         return GS_ERANGE;
     }
@@ -163,39 +167,56 @@ struct Blob {
     std::vector<cv::Point> hull_s;  // convex hull, small image
     double cx_s, cy_s;              // centroid, small image
     double d_eq_s;                  // equivalent diameter from the area, small image
+    double d_minor_s;               // 4 sqrt(smallest eigenvalue) of the mask, small image
     double elong;                   // sqrt(l1/l2) of the blob's mask
-    double hue_deg, sat, val;       // mean colour (hue: saturation-weighted circular mean)
     bool at_edge;                   // touches the frame's border
 };
 
 struct Meas {
     bool ok = false;
     double x = kNaN, y = kNaN;      // alpha centroid, full resolution
-    double d_perp = kNaN;           // 4 sqrt(lambda_min)
+    double d_perp = kNaN;           // 4 sqrt(lambda_min - psf^2)
     double d_area = kNaN;           // 2 sqrt(sum alpha / pi)
     double ratio = kNaN;            // sqrt(lambda_max / lambda_min)
+    double sxx = kNaN, syy = kNaN, sxy = kNaN;  // alpha covariance (px^2)
+    double d_kurt = kNaN;           // across the motion from the 2nd and 4th moments (any Gaussian blur)
+    double psf_var = kNaN;          // the blur's variance that implies (px^2)
     bool at_edge = false;
+    bool shadow = false;            // a darkening of the background that keeps its texture
+    bool shadow_color = false;      // darker than the background in its own colour (a shadow, or a grey ball)
     cv::Vec3f color;                // mean colour of the ball's core pixels
     double contrast = 0.0;          // |C - B|
 };
 
-struct Hist {
-    double t, x, y, d;
+// one detection of a track
+struct Pt {
+    double t = 0;
+    int64_t frame = 0;
+    double x = 0, y = 0;            // full resolution (alpha centroid, or the blob's centroid)
+    double d = 0;                   // diameter across the motion (or the blob's), px
+    Meas m;
 };
 
 struct Track {
-    int id = -1;
-    double x = 0, y = 0, vx = 0, vy = 0, t = 0;
-    double d = 0;                  // running diameter estimate (full res)
+    int id = -1;                   // output number (confirmed tracks only)
+    bool confirmed = false;
+    std::vector<Pt> arc;           // detections since the last break of the parabola
+    Pt last;                       // the newest detection (also when it started a new arc)
+    bool has_last = false;
+    double d = 0;                  // running diameter (full res)
+    double d_prev = kNaN;          // running diameter before the newest detection
     int hits = 0, misses = 0;
+    bool matched = false;
     bool have_color = false;
     cv::Vec3f color;               // ball colour from sharp frames
-    std::vector<Hist> hist;        // recent centres (auto colour learning)
-    std::vector<Blob> blobs;       // recent blobs (auto colour learning)
-    std::vector<Hist> seg;         // raw centres since the last bounce (rolling shutter)
-    bool matched = false;
-    bool dead = false;             // dropped when the colour was learned from another track
+    Parabola fit;                  // of the arc's newest points (prediction)
+    double t_confirmed = kNaN;
 };
+
+constexpr size_t kArcKeep = 400;   // detections of an arc kept (1000 fps: 0.4 s)
+constexpr size_t kFitLast = 24;    // newest arc points in the prediction fit
+constexpr size_t kMaxTracks = 48;  // tentative and confirmed
+constexpr size_t kMaxBlobs = 64;
 
 // Rolling shutter: a row y is exposed k (y - H/2) later than the middle row, so a
 // ball moving at v appears displaced by v k (y - H/2). k is unknown (readout time,
@@ -206,95 +227,94 @@ constexpr double kRsMax = 1.0;
 
 double rs_k_rel(int i) { return -kRsMax + 2.0 * kRsMax * i / (kRsSteps - 1); }
 
-// quadratic least squares y = c0 + c1 t + c2 t^2 ; returns rms residual
-bool fit_quad(const std::vector<double> &t, const std::vector<double> &y, double c[3], double *rms)
+double median(std::vector<double> v)
 {
-    size_t n = t.size();
-    if (n < 4) return false;
-    double t0 = 0;
-    for (double v : t) t0 += v;
-    t0 /= (double)n;
-    cv::Mat A((int)n, 3, CV_64F), b((int)n, 1, CV_64F), x;
-    for (size_t i = 0; i < n; i++) {
-        double u = t[i] - t0;
-        A.at<double>((int)i, 0) = 1.0;
-        A.at<double>((int)i, 1) = u;
-        A.at<double>((int)i, 2) = u * u;
-        b.at<double>((int)i, 0) = y[i];
-    }
-    if (!cv::solve(A, b, x, cv::DECOMP_SVD)) return false;
-    double ss = 0;
-    for (size_t i = 0; i < n; i++) {
-        double u = t[i] - t0;
-        double r = y[i] - (x.at<double>(0) + x.at<double>(1) * u + x.at<double>(2) * u * u);
-        ss += r * r;
-    }
-    c[0] = x.at<double>(0);
-    c[1] = x.at<double>(1);
-    c[2] = x.at<double>(2);
-    *rms = std::sqrt(ss / (double)(n > 3 ? n - 3 : 1));
-    return true;
+    if (v.empty()) return kNaN;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Parabola fit_points(const std::vector<Pt> &pts, size_t last_n)
+{
+    size_t n = std::min(last_n, pts.size());
+    std::vector<TrackPoint> tp;
+    tp.reserve(n);
+    for (size_t i = pts.size() - n; i < pts.size(); i++) tp.push_back({pts[i].t, pts[i].x, pts[i].y, 1.0});
+    return fit_parabola(tp);
 }
 
 }  // namespace
 
 struct BallDetector::Impl {
     BallConfig cfg;
-    bool color_known = false;
+    bool hue_set = false;
     double hue = 0, hue_tol = 16, sat_min = 0.25, val_min = 0.15;
     double scale = 1.0;            // small = full * scale
+    double max_d_px = 400.0;       // the diameter range in use (full res)
     cv::Mat bg_small, bg_full;     // CV_32FC3 running backgrounds
     cv::Mat small, hsv, motion, cand;
-    cv::Mat bg_sat;                // the background's HSV saturation (working resolution)
-    long bg_sat_frame = -100;
     std::vector<cv::Rect> keep_s;  // regions (working resolution) the background must not learn this frame
     std::vector<Track> tracks;
     long frame = 0;
     double dt = 1.0 / 30.0;        // typical frame interval
     double last_t = kNaN;
+    bool backlog = false;
+    // gravity in the image, learnt from confirmed flights (unit vector, image down at first)
+    double gx = 0.0, gy = 1.0;
+    int g_n = 0;
     double rs_sse[kRsSteps] = {};  // accumulated quadratic-fit SSE per k over finished flights
     int rs_segments = 0;
     double rs_k = 0.0;             // seconds per row in use (0 = no correction)
-    double rs_ay[kRsSteps] = {};   // last fitted vertical acceleration per k (px/s^2)
-    double rs_ay_best = 0.0;
-
-    void rs_segment(const std::vector<Hist> &seg, int rows);
-    void rs_correct(const Track &tr, double rows, double *x, double *y) const;
 
     explicit Impl(const BallConfig &c) : cfg(c)
     {
         hue_tol = c.hue_tol_deg;
         if (!c.color_auto && c.hue_deg >= 0.0) {
-            color_known = true;
+            hue_set = true;
             hue = c.hue_deg;
             sat_min = c.sat_min;
             val_min = c.val_min;
         }
     }
 
-    void find_blobs(const cv::Mat &mask, std::vector<Blob> &blobs, bool need_sat);
+    void find_blobs(const cv::Mat &mask, std::vector<Blob> &blobs);
     Meas measure(const cv::Mat &bgr, const Blob &b, const Track *tr);
-    void learn_color(Track &tr);
-    bool ballistic(const Track &tr) const;
+    bool is_ball(const Track &tr) const;
+    bool shadow_of_another(const Track &tr) const;
+    void rs_segment(const std::vector<Pt> &arc, int rows);
+    void rs_correct(double vx, double vy, double rows, double *x, double *y) const;
+    bool make_obs(const Track &tr, const Pt &p, double vx, double vy, int rows, BallObs &o) const;
     void process(const cv::Mat &bgr, double t_s, std::vector<BallObs> &out);
 };
 
-void BallDetector::Impl::find_blobs(const cv::Mat &mask, std::vector<Blob> &blobs, bool need_sat)
+void BallDetector::Impl::find_blobs(const cv::Mat &mask, std::vector<Blob> &blobs)
 {
     std::vector<std::vector<cv::Point>> contours;
     cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-    double dmin = cfg.min_diameter_px * scale, dmax = cfg.max_diameter_px * scale;
+    double dmin = cfg.min_diameter_px * scale, dmax = max_d_px * scale;
     for (const auto &c : contours) {
         cv::Rect box = cv::boundingRect(c);
         if (box.width < 0.5 * dmin && box.height < 0.5 * dmin) continue;
         if (box.width > 4.5 * dmax || box.height > 4.5 * dmax) continue;
-        cv::Mat m = cv::Mat::zeros(box.size(), CV_8U);
-        std::vector<std::vector<cv::Point>> one{c};
-        cv::drawContours(m, one, 0, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
-                         -box.tl());
-        cv::Moments mo = cv::moments(m, true);
-        if (mo.m00 < 4.0) continue;
+        cv::Moments mo = cv::moments(c, false);
         double area = mo.m00;
+        if (c.size() < 5 || area < 1.0) {
+            // a speck of a few pixels: moments of its filled box
+            if (!(dmin <= 3.0)) continue;
+            area = std::max(1.0, (double)box.area());
+            Blob b;
+            b.box_s = box;
+            cv::convexHull(c, b.hull_s);
+            b.cx_s = box.x + 0.5 * (box.width - 1);
+            b.cy_s = box.y + 0.5 * (box.height - 1);
+            b.d_eq_s = 2.0 * std::sqrt(area / CV_PI);
+            b.d_minor_s = std::min(box.width, box.height);
+            b.elong = (double)std::max(box.width, box.height) / std::max(1, std::min(box.width, box.height));
+            b.at_edge = box.x <= 0 || box.y <= 0 || box.br().x >= mask.cols || box.br().y >= mask.rows;
+            if (b.elong <= 4.0) blobs.push_back(std::move(b));
+            continue;
+        }
         double deq = 2.0 * std::sqrt(area / CV_PI);
         double mu20 = mo.mu20 / area, mu02 = mo.mu02 / area, mu11 = mo.mu11 / area;
         double tr = mu20 + mu02, det = mu20 * mu02 - mu11 * mu11;
@@ -302,42 +322,28 @@ void BallDetector::Impl::find_blobs(const cv::Mat &mask, std::vector<Blob> &blob
         double l1 = tr / 2.0 + disc, l2 = std::max(1e-6, tr / 2.0 - disc);
         double elong = std::sqrt(l1 / l2);
         double dminor = 4.0 * std::sqrt(l2);
-        if (dminor < 0.6 * dmin || dminor > 1.3 * dmax) continue;
+        if (dminor < 0.6 * dmin - 1.0 || dminor > 1.3 * dmax) continue;
         if (elong > 4.0) continue;
         // solidity: a ball (blurred or not) is convex
         std::vector<cv::Point> hull;
         cv::convexHull(c, hull);
         double harea = cv::contourArea(hull);
-        if (harea > 0 && area / (harea + 0.5 * cv::arcLength(hull, true)) < 0.72) continue;
+        if (harea > 0 && area / (harea + 0.5 * cv::arcLength(hull, true)) < 0.6) continue;
         Blob b;
         b.box_s = box;
         b.hull_s = hull;
-        b.cx_s = box.x + mo.m10 / mo.m00;
-        b.cy_s = box.y + mo.m01 / mo.m00;
+        b.cx_s = mo.m10 / mo.m00;
+        b.cy_s = mo.m01 / mo.m00;
         b.d_eq_s = deq;
+        b.d_minor_s = dminor;
         b.elong = elong;
         b.at_edge = box.x <= 0 || box.y <= 0 || box.br().x >= mask.cols || box.br().y >= mask.rows;
-        // colour statistics of the blob
-        cv::Mat h = hsv(box);
-        double sx = 0, sy = 0, ss = 0, sv = 0, n = 0;
-        for (int y = 0; y < box.height; y++) {
-            const uchar *mr = m.ptr<uchar>(y);
-            const cv::Vec3b *hr = h.ptr<cv::Vec3b>(y);
-            for (int x = 0; x < box.width; x++) {
-                if (!mr[x]) continue;
-                double s = hr[x][1] / 255.0, a = hr[x][0] * 2.0 * CV_PI / 180.0;
-                sx += s * std::cos(a);
-                sy += s * std::sin(a);
-                ss += s;
-                sv += hr[x][2] / 255.0;
-                n += 1;
-            }
-        }
-        b.hue_deg = std::fmod(std::atan2(sy, sx) * 180.0 / CV_PI + 360.0, 360.0);
-        b.sat = ss / n;
-        b.val = sv / n;
-        if (need_sat && b.sat < 0.18) continue;
         blobs.push_back(std::move(b));
+    }
+    // many blobs: a scene change or a crowd; the roundest, ball-sized ones first
+    if (blobs.size() > kMaxBlobs) {
+        std::sort(blobs.begin(), blobs.end(), [](const Blob &a, const Blob &b) { return a.elong < b.elong; });
+        blobs.resize(kMaxBlobs);
     }
 }
 
@@ -360,7 +366,12 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     for (const auto &p : b.hull_s)
         hull.emplace_back((int)std::lround((p.x + 0.5) * inv - 0.5) - roi.x,
                           (int)std::lround((p.y + 0.5) * inv - 0.5) - roi.y);
-    cv::fillConvexPoly(sup, hull, cv::Scalar(255));
+    if (hull.size() >= 3)
+        cv::fillConvexPoly(sup, hull, cv::Scalar(255));
+    else
+        cv::rectangle(sup, cv::Rect(cv::Point((int)(b.box_s.x * inv) - roi.x, (int)(b.box_s.y * inv) - roi.y),
+                                    cv::Size((int)std::ceil(b.box_s.width * inv), (int)std::ceil(b.box_s.height * inv))),
+                      cv::Scalar(255), cv::FILLED);
     int k = (int)std::ceil(0.12 * dfull + 1.5 + inv);
     cv::dilate(sup, sup, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
     cv::Mat I = bgr(roi), B = bg_full(roi);
@@ -377,8 +388,8 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
             px.emplace_back((float)d.dot(d), cv::Vec3f(ir[x][0], ir[x][1], ir[x][2]));
         }
     }
-    if (px.size() < 8) return r;
-    size_t top = std::max<size_t>(4, px.size() / 4);
+    if (px.size() < 4) return r;
+    size_t top = std::max<size_t>(2, px.size() / 4);
     std::nth_element(px.begin(), px.begin() + (long)top, px.end(),
                      [](const auto &a, const auto &c) { return a.first > c.first; });
     cv::Vec3f C(0, 0, 0);
@@ -388,16 +399,25 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     // A shaded ball is its colour times a shading factor s (the side away from the
     // light is darker): I = u C + (1 - alpha) B with u = alpha s unknown too, so
     // alpha comes from a 2x2 least-squares unmixing against C and B. Where C and B
-    // are nearly parallel (the same chromaticity) that is ill-posed and the plain
-    // projection alpha = (I-B).(C-B)/|C-B|^2 (s = 1) is used.
+    // are nearly parallel (the same chromaticity: a grey ball, a white ball on a
+    // grey wall) that is ill-posed and the plain projection alpha = (I-B).(C-B)/|C-B|^2
+    // (s = 1) is used.
+    // A shadow on the background is the background darkened (u = 0, beta < 1): in
+    // the unmixing it would pass for coverage 1 - beta, so coverage also needs the
+    // ball's own colour: alpha <= u / (0.35 u_ref), u_ref the ball's typical u
+    // (its shading may darken it to 35 % of that before it counts as less ball).
+    cv::Mat uw(roi.size(), CV_32F, cv::Scalar(-1));
     auto compute_alpha = [&](const cv::Vec3f &col) {
         const double cc = col.dot(col);
+        std::vector<float> core_u;
         for (int y = 0; y < roi.height; y++) {
             const uchar *s = sup.ptr<uchar>(y);
             const cv::Vec3b *ir = I.ptr<cv::Vec3b>(y);
             const cv::Vec3f *br = B.ptr<cv::Vec3f>(y);
             float *ar = alpha.ptr<float>(y);
+            float *ur = uw.ptr<float>(y);
             for (int x = 0; x < roi.width; x++) {
+                ur[x] = -1.f;
                 if (!s[x]) { ar[x] = 0.f; continue; }
                 cv::Vec3f v = col - br[x];
                 float vv = v.dot(v);
@@ -409,12 +429,26 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
                 if (det > 0.03 * cc * bb) {  // C and B at least ~10 deg apart (noise grows as 1 / sin)
                     double ci = col.dot(iv), bi = br[x].dot(iv);
                     double beta = (cc * bi - cb * ci) / det;    // weight of the background
+                    double u = (bb * ci - cb * bi) / det;       // weight of the ball's colour
                     a = (float)(1.0 - beta);
+                    ur[x] = (float)u;
+                    if (a > 0.8f) core_u.push_back((float)u);
                 } else {
                     a = (iv - br[x]).dot(v) / vv;
                 }
                 ar[x] = std::min(1.5f, std::max(-0.5f, a));
             }
+        }
+        if (core_u.size() < 4) return;
+        std::nth_element(core_u.begin(), core_u.begin() + (long)(core_u.size() / 2), core_u.end());
+        const float u_ref = core_u[core_u.size() / 2];
+        if (!(u_ref > 0.2f)) return;
+        const float inv_u = 1.0f / (0.35f * u_ref);
+        for (int y = 0; y < roi.height; y++) {
+            float *ar = alpha.ptr<float>(y);
+            const float *ur = uw.ptr<float>(y);
+            for (int x = 0; x < roi.width; x++)
+                if (ur[x] > -0.99f || ur[x] < -1.01f) ar[x] = std::min(ar[x], std::max(-0.5f, ur[x] * inv_u));
         }
     };
     compute_alpha(C);
@@ -434,10 +468,30 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     r.color = C;
     if (tr && tr->have_color) C = tr->color;
     compute_alpha(C);
-    // moments
+    // the ball is one compact region: its confident core (the largest component of
+    // alpha > 0.5) widened by the edge's blur; what lies beyond (a shadow beside
+    // it, a hand, the ghost of where it lay) is no part of it
+    {
+        cv::Mat core = alpha > 0.5f, lab, stats, cents;
+        int nl = cv::connectedComponentsWithStats(core, lab, stats, cents, 8, CV_32S);
+        int best = 0, best_area = 0;
+        for (int l = 1; l < nl; l++)
+            if (stats.at<int>(l, cv::CC_STAT_AREA) > best_area) { best_area = stats.at<int>(l, cv::CC_STAT_AREA); best = l; }
+        if (best > 0) {
+            cv::Mat keep = lab == best;
+            int e = (int)std::ceil(0.06 * std::sqrt(best_area * 4.0 / CV_PI) + 2.0 * cfg.psf_sigma_px + 2.0);
+            cv::dilate(keep, keep, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * e + 1, 2 * e + 1)));
+            alpha.setTo(0.0f, ~keep);
+        }
+    }
+    // moments; and whether the core is a shadow: the background darkened by one
+    // factor in every channel, its texture still there
     double m0 = 0, mx = 0, my = 0, mxx = 0, myy = 0, mxy = 0;
+    double sh_n = 0, sh_r = 0, sh_rr = 0, sh_chroma = 0, si = 0, sb = 0, sii = 0, sbb = 0, sib = 0;
     for (int y = 0; y < roi.height; y++) {
         const float *ar = alpha.ptr<float>(y);
+        const cv::Vec3b *ir = I.ptr<cv::Vec3b>(y);
+        const cv::Vec3f *br = B.ptr<cv::Vec3f>(y);
         for (int x = 0; x < roi.width; x++) {
             /* the ball covers a pixel between none and all of it: shading above 1 and
              * shadows or noise below a small floor would widen the measured disc */
@@ -449,19 +503,63 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
             mxx += a * x * x;
             myy += a * y * y;
             mxy += a * x * y;
+            if (a > 0.6) {
+                double rb = (ir[x][0] + 1.0) / (br[x][0] + 1.0), rg = (ir[x][1] + 1.0) / (br[x][1] + 1.0),
+                       rr = (ir[x][2] + 1.0) / (br[x][2] + 1.0);
+                double rm = (rb + rg + rr) / 3.0;
+                sh_r += rm;
+                sh_rr += rm * rm;
+                sh_chroma += (std::fabs(rb - rm) + std::fabs(rg - rm) + std::fabs(rr - rm)) / (3.0 * rm);
+                double iv = ir[x][0] + ir[x][1] + ir[x][2], bv = br[x][0] + br[x][1] + br[x][2];
+                si += iv; sb += bv; sii += iv * iv; sbb += bv * bv; sib += iv * bv;
+                sh_n += 1;
+            }
         }
     }
-    if (!(m0 > 4.0)) return r;
+    if (!(m0 > 1.5)) return r;
+    if (const char *dd = std::getenv("GS_BALL_DEBUG_DIR")) {
+        char path[512];
+        std::snprintf(path, sizeof path, "%s/a%04ld_%d_%d.png", dd, frame, roi.x, roi.y);
+        cv::Mat a8;
+        alpha.convertTo(a8, CV_8U, 200.0);
+        cv::imwrite(path, a8);
+    }
     double cx = mx / m0, cy = my / m0;
     double sxx = mxx / m0 - cx * cx, syy = myy / m0 - cy * cy, sxy = mxy / m0 - cx * cy;
     double trc = sxx + syy, det = sxx * syy - sxy * sxy;
     double disc = std::sqrt(std::max(0.0, trc * trc / 4.0 - det));
     double l1 = trc / 2.0 + disc, l2 = trc / 2.0 - disc;
     if (!(l2 > 0.0)) return r;
+    // the fourth moment across the motion (the minor axis): a disc of radius R blurred
+    // by a Gaussian of any width has m2 = R^2/4 + s^2 and m4 = 3 m2^2 - R^4/16 there
+    {
+        double nx = -sxy, ny = sxx - l2;  // eigenvector of l2
+        if (std::hypot(nx, ny) < 1e-9) { nx = syy - l2; ny = -sxy; }
+        if (std::hypot(nx, ny) < 1e-9) { nx = 1.0; ny = 0.0; }
+        double nn = std::hypot(nx, ny);
+        nx /= nn;
+        ny /= nn;
+        double m4 = 0.0;
+        for (int y = 0; y < roi.height; y++) {
+            const float *ar = alpha.ptr<float>(y);
+            for (int x = 0; x < roi.width; x++) {
+                double a = std::min(1.0, (double)ar[x]);
+                if (!(a >= kAlphaFloor)) continue;
+                double d = (x - cx) * nx + (y - cy) * ny;
+                m4 += a * d * d * d * d;
+            }
+        }
+        m4 /= m0;
+        double A2 = 3.0 * l2 * l2 - m4;
+        r.d_kurt = A2 > 0.0 ? 4.0 * std::pow(A2, 0.25) : kNaN;
+        r.psf_var = A2 > 0.0 ? l2 - std::sqrt(A2) : kNaN;
+    }
     r.ok = true;
     r.x = roi.x + cx;
     r.y = roi.y + cy;
-    r.d_perp = 4.0 * std::sqrt(l2);
+    r.sxx = sxx;
+    r.syy = syy;
+    r.sxy = sxy;
     r.d_area = 2.0 * std::sqrt(m0 / CV_PI);
     // a disc's variance D^2/16 plus the camera's blur variance: take the blur off
     // (it widens small balls by several per cent; floor: never below half the width)
@@ -469,6 +567,15 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     r.d_perp = 4.0 * std::sqrt(std::max(0.25 * l2, l2 - psf2));
     r.ratio = std::sqrt(l1 / l2);
     r.at_edge = (box & frame_r) != box;
+    if (sh_n >= 6) {
+        double rm = sh_r / sh_n, chroma = sh_chroma / sh_n;
+        double vi = sii / sh_n - (si / sh_n) * (si / sh_n), vb = sbb / sh_n - (sb / sh_n) * (sb / sh_n);
+        double cib = sib / sh_n - (si / sh_n) * (sb / sh_n);
+        double corr = vi > 0 && vb > 0 ? cib / std::sqrt(vi * vb) : 0.0;
+        // a texture of at least ~3 grey levels (x3 channels) that the pixels follow
+        r.shadow_color = rm > 0.25 && rm < 0.9 && chroma < 0.07;
+        r.shadow = r.shadow_color && vb > 81.0 && corr > 0.6;
+    }
     cv::Vec3f bgm(0, 0, 0);
     {
         int cxi = std::min(roi.width - 1, std::max(0, (int)cx));
@@ -480,131 +587,191 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     return r;
 }
 
-bool BallDetector::Impl::ballistic(const Track &tr) const
+// The ballistic test: the arc's newest detections are explained by a parabola
+// whose acceleration points along gravity (image down within 40 degrees until
+// flights have shown it, then within 15 degrees of it), implies a size of
+// 1 cm to 1 m under g, is clearly above its noise, and the object is compact,
+// of a steady size, moved at least two diameters and is no shadow.
+bool BallDetector::Impl::is_ball(const Track &tr) const
 {
-    size_t n = tr.hist.size();
-    if (n < 6) return false;
-    // the last 0.1 s (at least 6 frames): at 120 fps six frames are too short to see a drop move
-    size_t use = 6;
-    while (use < n && use < tr.blobs.size() && tr.hist.back().t - tr.hist[n - use - 1].t <= 0.1 + 1e-6) use++;
-    std::vector<double> t, x, y;
+    size_t n = tr.arc.size();
+    if (n < 5) return false;
+    size_t first = n - std::min(n, kFitLast);
     std::vector<double> ds;
-    for (size_t i = n - use; i < n; i++) {
-        t.push_back(tr.hist[i].t);
-        x.push_back(tr.hist[i].x);
-        y.push_back(tr.hist[i].y);
-        ds.push_back(tr.hist[i].d);
+    std::vector<TrackPoint> tp;
+    for (size_t i = first; i < n; i++) {
+        ds.push_back(tr.arc[i].d);
+        tp.push_back({tr.arc[i].t, tr.arc[i].x, tr.arc[i].y, 1.0});
+    }
+    double D = median(ds);
+    // the candidates a free fall explains (one wrong link, a frame merged with a hand, is left out)
+    const double g = 9.81;
+    FallPrior prior;
+    prior.a_min = g * D / 1.0;
+    prior.a_max = g * D / 0.01;
+    prior.gx = gx;
+    prior.gy = gy;
+    prior.cos_min = g_n >= 1 ? std::cos(15.0 * CV_PI / 180.0) : std::cos(40.0 * CV_PI / 180.0);
+    std::vector<bool> in;
+    Parabola f = ransac_parabola(tp, std::max(1.0, 0.12 * D), 200, in, 1, prior);
+    size_t n_in = (size_t)std::count(in.begin(), in.end(), true);
+    if (!f.ok || n_in < 5 || 5 * n_in < 4 * tp.size() || !in.back()) return false;
+    ds.clear();
+    int shadows = 0, edges = 0;
+    double path = 0.0;
+    const Pt *prev = nullptr;
+    for (size_t i = first; i < n; i++) {
+        if (!in[i - first]) continue;
+        ds.push_back(tr.arc[i].d);
+        shadows += tr.arc[i].m.shadow ? 1 : 0;
+        edges += tr.arc[i].m.at_edge ? 1 : 0;
+        if (prev) path += std::hypot(tr.arc[i].x - prev->x, tr.arc[i].y - prev->y);
+        prev = &tr.arc[i];
     }
     std::sort(ds.begin(), ds.end());
-    double D = ds[ds.size() / 2];
-    double cy[3], cx[3], ry, rx;
-    if (!fit_quad(t, y, cy, &ry) || !fit_quad(t, x, cx, &rx)) return false;
-    double ay = 2.0 * cy[2], ax = 2.0 * cx[2];
-    double span = std::hypot(x.back() - x.front(), y.back() - y.front());
-    // g / a_px = size in metres / D: sizes 2 cm .. 50 cm (with slack)
-    bool a_ok = ay > 10.0 * D && ay < 1000.0 * D && std::fabs(ax) < 0.7 * ay;
-    bool fit_ok = ry < std::max(1.5, 0.12 * D) && rx < std::max(1.5, 0.12 * D);
+    double a = std::hypot(f.ax, f.ay);
+    double cosang = a > 0 ? (f.ax * gx + f.ay * gy) / a : -1.0;
+    double a_se = std::hypot(f.ax_se, f.ay_se);
+    bool a_ok = a > 4.0 * a_se;
+    bool fit_ok = f.rms_px <= std::max(0.6, 0.1 * D);
+    bool steady = ds.front() > 0.6 * ds.back();
+    bool moved = path >= 2.0 * D;
+    bool no_shadow = shadows * 2 < (int)n_in && edges * 2 < (int)n_in;
     if (std::getenv("GS_BALL_DEBUG"))
-        std::fprintf(stderr, "ballistic? t=%.3f D=%.1f ay=%.1f ax=%.1f ry=%.2f rx=%.2f span=%.1f hue=%.0f sat=%.2f\n",
-                     t.back(), D, ay, ax, ry, rx, span, tr.blobs.back().hue_deg, tr.blobs.back().sat);
-    if (!(a_ok && fit_ok && span > 3.0 * D && ds.front() > 0.67 * ds.back())) return false;
-    // one colour: the blobs' hues agree and are saturated; none touches the frame's edge
-    double sx = 0, sy = 0;
-    size_t nb = tr.blobs.size();
-    if (nb < use) return false;
-    for (size_t i = nb - use; i < nb; i++) {
-        const Blob &b = tr.blobs[i];
-        if (b.sat < 0.25 || b.at_edge) return false;
-        sx += std::cos(b.hue_deg * CV_PI / 180.0);
-        sy += std::sin(b.hue_deg * CV_PI / 180.0);
-    }
-    return std::hypot(sx, sy) / (double)use > 0.95;  // circular spread below ~18 degrees
+        std::fprintf(stderr, "ball? t=%.3f n=%zu D=%.1f a=%.0f (%.0f,%.0f) se=%.0f cos=%.2f size=%.3f rms=%.2f steady=%d moved=%.1f shadows=%d -> %d\n",
+                     tr.arc.back().t, f.n, D, a, f.ax, f.ay, a_se, cosang, a > 0 ? g * D / a : 0.0, f.rms_px,
+                     steady, path / std::max(1e-9, D), shadows, a_ok && fit_ok && steady && moved && no_shadow);
+    return a_ok && fit_ok && steady && moved && no_shadow;
 }
 
-void BallDetector::Impl::learn_color(Track &tr)
+// A shadow cast by a flying ball flies a parabola too. A track darker than the
+// background in the background's own colour is taken for a shadow while another
+// track, not so coloured, moves in step with it (its arc began within two frames
+// and it accelerates the same way); alone it may be a grey or black ball.
+bool BallDetector::Impl::shadow_of_another(const Track &tr) const
 {
-    double sx = 0, sy = 0;
-    std::vector<double> s, v;
-    for (size_t i = tr.blobs.size() - 6; i < tr.blobs.size(); i++) {
-        const Blob &b = tr.blobs[i];
-        double a = b.hue_deg * CV_PI / 180.0;
-        sx += std::cos(a);
-        sy += std::sin(a);
-        s.push_back(b.sat);
-        v.push_back(b.val);
+    size_t n = tr.arc.size(), sc = 0;
+    for (const Pt &p : tr.arc) sc += p.m.shadow_color ? 1 : 0;
+    if (2 * sc <= n || !tr.fit.ok) return false;
+    for (const Track &o : tracks) {
+        if (&o == &tr || o.arc.size() < 3 || !o.fit.ok || o.last.t != tr.last.t) continue;
+        size_t oc = 0;
+        for (const Pt &p : o.arc) oc += p.m.shadow_color ? 1 : 0;
+        if (2 * oc > o.arc.size()) continue;
+        bool same_start = std::fabs(o.arc.front().t - tr.arc.front().t) <= 2.5 * dt || o.arc.size() >= n;
+        double a1 = std::hypot(tr.fit.ax, tr.fit.ay), a2 = std::hypot(o.fit.ax, o.fit.ay);
+        double va = tr.fit.vy_at(tr.last.t), vb = o.fit.vy_at(o.last.t);
+        bool same_motion = a2 > 0.5 * a1 && a2 < 2.0 * a1 && va * vb > 0;
+        if (same_start && same_motion) return true;
     }
-    std::sort(s.begin(), s.end());
-    std::sort(v.begin(), v.end());
-    hue = std::fmod(std::atan2(sy, sx) * 180.0 / CV_PI + 360.0, 360.0);
-    sat_min = std::max(0.12, 0.45 * s[s.size() / 2]);
-    val_min = std::max(0.08, 0.35 * v[v.size() / 2]);
-    color_known = true;
+    return false;
 }
 
-void BallDetector::Impl::rs_segment(const std::vector<Hist> &seg0, int rows)
+void BallDetector::Impl::rs_segment(const std::vector<Pt> &seg0, int rows)
 {
-    // drop one sample at each end (contact) and require a long, tall flight
-    if (seg0.size() < 14) return;
-    std::vector<Hist> seg(seg0.begin() + 2, seg0.end() - 2);
+    // drop two samples at each end (contact) and require a long, tall flight
+    if (seg0.size() < 10) return;
+    std::vector<Pt> seg(seg0.begin() + 2, seg0.end() - 2);
     double ymin = 1e30, ymax = -1e30;
     for (const auto &h : seg) { ymin = std::min(ymin, h.y); ymax = std::max(ymax, h.y); }
-    if (ymax - ymin < 0.2 * rows) return;
+    if (ymax - ymin < 0.1 * rows) return;
     size_t n = seg.size();
-    std::vector<double> t(n), yc(n), v(n);
+    std::vector<double> v(n);
     for (size_t i = 0; i < n; i++) {
         size_t a = i > 0 ? i - 1 : i, b = i + 1 < n ? i + 1 : i;
         v[i] = (seg[b].y - seg[a].y) / (seg[b].t - seg[a].t);
-        t[i] = seg[i].t;
     }
     double sse[kRsSteps];
+    std::vector<TrackPoint> tp(n);
     for (int k = 0; k < kRsSteps; k++) {
         double ks = rs_k_rel(k) * dt / rows;
-        for (size_t i = 0; i < n; i++) yc[i] = seg[i].y - v[i] * ks * (seg[i].y - 0.5 * rows);
-        double c[3], rms;
-        if (!fit_quad(t, yc, c, &rms)) return;
-        sse[k] = rms * rms;
-        rs_ay[k] = 2.0 * c[2];
+        for (size_t i = 0; i < n; i++) tp[i] = {seg[i].t, seg[i].x, seg[i].y - v[i] * ks * (seg[i].y - 0.5 * rows), 1.0};
+        // the vertical residual only (x is not sheared by a vertical velocity)
+        std::vector<TrackPoint> ty(tp);
+        for (auto &q : ty) q.x_px = 0.0;
+        Parabola f = fit_parabola(ty);
+        if (!f.ok) return;
+        sse[k] = 2.0 * f.rms_px * f.rms_px;
     }
     for (int k = 0; k < kRsSteps; k++) rs_sse[k] += sse[k];
     rs_segments++;
     int best = 0;
     for (int k = 1; k < kRsSteps; k++)
         if (rs_sse[k] < rs_sse[best]) best = k;
-    rs_ay_best = rs_ay[best];
     int zero = (kRsSteps - 1) / 2;
     // only a clear improvement counts (a global shutter stays uncorrected): the rms at
     // least 40 % lower, at a k inside the grid (a k at its edge fits something else,
-    // e.g. a hand still holding the ball at the segment's start: bounceAmeen's first drop)
+    // e.g. a hand still holding the ball at the segment's start)
     bool inside = best > 0 && best < kRsSteps - 1;
-    rs_k = inside && rs_sse[best] < 0.36 * rs_sse[zero] ? rs_k_rel(best) * dt / rows : 0.0;
+    // and only a residual above the centres' own noise (a quarter pixel) has a shutter to explain
+    bool visible = rs_sse[zero] / rs_segments > 0.25 * 0.25;
+    rs_k = inside && visible && rs_sse[best] < 0.36 * rs_sse[zero] ? rs_k_rel(best) * dt / rows : 0.0;
     if (std::getenv("GS_BALL_DEBUG"))
         std::fprintf(stderr, "rolling shutter: %d flights, k_rel %.2f, rms %.2f -> %.2f px\n", rs_segments,
                      rs_k_rel(best), std::sqrt(rs_sse[zero] / rs_segments),
                      std::sqrt(rs_sse[best] / rs_segments));
 }
 
-void BallDetector::Impl::rs_correct(const Track &tr, double rows, double *x, double *y) const
+void BallDetector::Impl::rs_correct(double vx, double vy, double rows, double *x, double *y) const
 {
-    if (rs_k == 0.0 || tr.seg.size() < 2) return;
-    size_t n = tr.seg.size();
-    const Hist &c = tr.seg[n - 1], &b = tr.seg[n - 2];
-    double vx, vy;
-    if (n >= 3) {  // second-order backward difference: exact on a parabola
-        const Hist &a = tr.seg[n - 3];
-        double h1 = c.t - b.t, h2 = b.t - a.t;
-        if (!(h1 > 0 && h2 > 0)) return;
-        double w0 = (2 * h1 + h2) / (h1 * (h1 + h2)), w1 = -(h1 + h2) / (h1 * h2), w2 = h1 / (h2 * (h1 + h2));
-        vx = w0 * c.x + w1 * b.x + w2 * a.x;
-        vy = w0 * c.y + w1 * b.y + w2 * a.y;
-    } else {  // just after a bounce: the chord plus the known fall of half a frame
-        double h = c.t - b.t;
-        if (!(h > 0)) return;
-        vx = (c.x - b.x) / h;
-        vy = (c.y - b.y) / h + 0.5 * rs_ay_best * h;
-    }
+    if (rs_k == 0.0 || !std::isfinite(vx) || !std::isfinite(vy)) return;
     double dtr = rs_k * (*y - 0.5 * rows);
     *x -= vx * dtr;
     *y -= vy * dtr;
+}
+
+// One detection as reported: centre corrected for the rolling shutter with the
+// velocity then; the diameter only where the matte is trustworthy.
+bool BallDetector::Impl::make_obs(const Track &tr, const Pt &p, double vx, double vy, int rows, BallObs &o) const
+{
+    const Meas &ms = p.m;
+    if (!ms.ok) return false;
+    o.track = tr.id;
+    o.frame = p.frame;
+    o.t_s = p.t;
+    o.x_px = ms.x;
+    o.y_px = ms.y;
+    rs_correct(vx, vy, rows, &o.x_px, &o.y_px);
+    double conf = 1.0;
+    bool good = true, moments = true;
+    if (ms.at_edge) { conf *= 0.3; good = false; moments = false; }
+    if (ms.ratio > cfg.max_blur_ratio) good = false;
+    conf *= std::max(0.2, 1.0 - 0.3 * std::max(0.0, ms.ratio - 1.2));
+    // the area and the width agree for an unoccluded ball (blur keeps both)
+    double cons = ms.d_area / ms.d_perp;
+    if (cons < 0.85 || cons > 1.25) { good = false; moments = false; conf *= 0.5; }
+    if (ms.contrast < 30.0) { conf *= 0.5; }
+    // a sudden change of size: partly hidden or merged with something (its centre is off too)
+    if (std::isfinite(tr.d_prev) && std::fabs(ms.d_perp / tr.d_prev - 1.0) > 0.08 && ms.ratio < cfg.max_blur_ratio) {
+        good = false;
+        conf *= 0.2;
+    }
+    if (ms.d_perp < cfg.min_diameter_px || ms.d_perp > max_d_px) { good = false; moments = false; conf *= 0.5; }
+    o.diameter_px = good ? ms.d_perp : kNaN;
+    o.diameter_kurt_px = good ? ms.d_kurt : kNaN;
+    o.psf_var_px2 = good ? ms.psf_var : kNaN;
+    o.confidence = std::min(1.0, std::max(0.05, conf));
+    if (moments) {
+        o.sxx = ms.sxx;
+        o.syy = ms.syy;
+        o.sxy = ms.sxy;
+        // the rolling shutter shears the ball's image as it moves its centre:
+        // x' = x + vx k dy, y' = y + (1 + vy k) dy; undo it on the moments
+        if (rs_k != 0.0 && std::isfinite(vx) && std::isfinite(vy)) {
+            double a = vx * rs_k, b = 1.0 + vy * rs_k;
+            if (std::fabs(b) > 0.2) {
+                // M = [[1, a], [0, b]], Sigma = M^-1 Sigma' M^-T
+                double i00 = 1.0, i01 = -a / b, i11 = 1.0 / b;
+                double sxx = o.sxx, syy = o.syy, sxy = o.sxy;
+                o.sxx = i00 * i00 * sxx + 2 * i00 * i01 * sxy + i01 * i01 * syy;
+                o.sxy = i00 * i11 * sxy + i01 * i11 * syy;
+                o.syy = i11 * i11 * syy;
+            }
+        }
+    } else {
+        o.sxx = o.syy = o.sxy = kNaN;
+    }
+    return true;
 }
 
 void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<BallObs> &out)
@@ -616,8 +783,10 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         dt = frame == 1 ? d : dt + 0.1 * (std::min(d, 3.0 * dt) - dt);
     }
     last_t = t_s;
+    const int64_t fidx = frame;
     frame++;
-    scale = std::min(1.0, 960.0 / bgr.cols);
+    scale = std::min(1.0, 960.0 / std::max(bgr.cols, bgr.rows));
+    max_d_px = cfg.max_diameter_px > 0.0 ? cfg.max_diameter_px : std::min(bgr.cols, bgr.rows) / 3.0;
     if (scale < 1.0)
         cv::resize(bgr, small, cv::Size(), scale, scale, cv::INTER_AREA);
     else
@@ -628,15 +797,29 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         tracks.clear();
         return;
     }
-    cv::cvtColor(small, hsv, cv::COLOR_BGR2HSV);
-    // motion: difference to the background, any channel
+    // motion: difference to the background, any channel (brighter, darker, any hue)
     cv::Mat bg8, diff;  // in 8 bits: the threshold is whole grey levels anyway, and it is ~4x cheaper
     bg_small.convertTo(bg8, CV_8UC3);
     cv::absdiff(small, bg8, diff);
     std::vector<cv::Mat> ch;
     cv::split(diff, ch);
     cv::Mat mx = cv::max(cv::max(ch[0], ch[1]), ch[2]);
-    motion = mx > cfg.motion_min;
+    // the threshold: motion_min, or well above the frame's typical difference when
+    // compression noise, flicker or a fade lift it (4 robust sigmas of it)
+    double thr = cfg.motion_min;
+    {
+        int hist[256] = {0};
+        int step = std::max(1, (int)(mx.total() / 20000));
+        int cnt = 0;
+        const uchar *pm = mx.ptr<uchar>(0);
+        if (mx.isContinuous())
+            for (size_t i = 0; i < mx.total(); i += (size_t)step) { hist[pm[i]]++; cnt++; }
+        int acc = 0, med = 0;
+        for (; med < 255 && acc + hist[med] < cnt / 2; med++) acc += hist[med];
+        thr = std::max(thr, 4.0 * 1.4826 * med);
+    }
+    motion = mx > thr;
+    double moving_share = cv::countNonZero(motion) / (double)motion.total();
     cv::Rect roi_s(0, 0, small.cols, small.rows);
     if (cfg.roi_set) {
         cv::Rect r((int)(cfg.roi_x * scale), (int)(cfg.roi_y * scale), (int)(cfg.roi_w * scale),
@@ -646,7 +829,8 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         motion &= keep;
     }
     std::vector<Blob> blobs;
-    if (color_known) {
+    if (hue_set) {
+        cv::cvtColor(small, hsv, cv::COLOR_BGR2HSV);
         double h = hue / 2.0, tol = hue_tol / 2.0;
         int smin = (int)std::lround(sat_min * 255.0), vmin = (int)std::lround(val_min * 255.0);
         cv::Mat cm;
@@ -667,78 +851,100 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         cv::Mat md;
         cv::dilate(motion, md, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
         cand = cm & md;
-        cv::morphologyEx(cand, cand, cv::MORPH_CLOSE,
-                         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
-        find_blobs(cand, blobs, false);
     } else {
-        // colour learning needs a coloured ball: pixels more saturated than the
-        // background there (shadows and ghosts keep the background's saturation)
-        if (frame - bg_sat_frame >= 8) {  // the background changes slowly: its saturation is refreshed every 8 frames
-            cv::Mat bghsv;
-            cv::cvtColor(bg8, bghsv, cv::COLOR_BGR2HSV);
-            cv::extractChannel(bghsv, bg_sat, 1);
-            bg_sat_frame = frame;
-        }
-        cv::Mat sat, val, satd;
-        cv::extractChannel(hsv, sat, 1);
-        cv::extractChannel(hsv, val, 2);
-        cv::subtract(sat, bg_sat, satd);
-        cv::Mat sat_ok = (satd > 38) & (sat > 64) & (val > 25);
-        motion &= sat_ok;
-        cv::morphologyEx(motion, cand, cv::MORPH_OPEN,
-                         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
-        cv::morphologyEx(cand, cand, cv::MORPH_CLOSE,
-                         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
-        find_blobs(cand, blobs, true);
+        cand = motion;
     }
+    // close small gaps (a ball's highlight or a thin seam can split it); specks go
+    // by size in find_blobs
+    cv::morphologyEx(cand, cand, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
+    find_blobs(cand, blobs);
     if (const char *dd = std::getenv("GS_BALL_DEBUG_DIR")) {
         char path[512];
         std::snprintf(path, sizeof path, "%s/m%04ld.png", dd, frame);
         cv::Mat vis = small.clone();
         vis.setTo(cv::Scalar(0, 0, 255), motion);
         vis.setTo(cv::Scalar(255, 0, 0), cand);
+        for (const Blob &b : blobs) cv::rectangle(vis, b.box_s, cv::Scalar(0, 255, 0), 1);
         cv::imwrite(path, vis);
     }
-    if (blobs.size() > 64) blobs.resize(64);  // a scene change: do not chase noise
 
-    // association: predicted position, greedy by distance
+    // association: each track's prediction (its arc's parabola, else its chord),
+    // confirmed balls first, then the longest tracks; greedy by normalised distance
+    const double diag = std::hypot(bgr.cols, bgr.rows);
     for (auto &tr : tracks) tr.matched = false;
     std::vector<int> blob_track(blobs.size(), -1);
-    struct Pair { double d; size_t b, t; };
+    struct Pair { int rank; double cost; size_t b, t; };
     std::vector<Pair> pairs;
     for (size_t ti = 0; ti < tracks.size(); ti++) {
         const Track &tr = tracks[ti];
-        double h = t_s - tr.t;
-        double px = (tr.x + tr.vx * h) * scale, py = (tr.y + tr.vy * h) * scale;
-        double speed = std::hypot(tr.vx, tr.vy) * h * scale;
-        double gate = 1.5 * tr.d * scale + 0.6 * speed + 3.0 + (tr.misses + 1) * 0.5 * tr.d * scale;
+        if (!tr.has_last) continue;
+        double h = t_s - tr.last.t;
+        double px, py, gate;
+        size_t na = tr.arc.size();
+        double D = std::max(tr.d, 2.0);
+        if (na >= 3 && tr.fit.ok) {
+            px = tr.fit.x(t_s);
+            py = tr.fit.y(t_s);
+            double v = std::hypot(tr.fit.vx_at(tr.last.t), tr.fit.vy_at(tr.last.t));
+            // a bounce or a catch turns the velocity: the gate admits a turn of a frame's travel
+            gate = 2.0 + 0.6 * D + 3.0 * tr.fit.rms_px + (tr.confirmed ? 1.2 : 0.3) * v * h;
+        } else if (tr.has_last && na >= 2) {
+            const Pt &a = tr.arc[na - 2], &b = tr.arc[na - 1];
+            double hv = b.t - a.t;
+            double vx = hv > 0 ? (b.x - a.x) / hv : 0.0, vy = hv > 0 ? (b.y - a.y) / hv : 0.0;
+            // gravity of up to a 1 cm ball's over the step
+            double amax = 9.81 * D / 0.01;
+            px = b.x + vx * h;
+            py = b.y + vy * h;
+            gate = 2.0 + 1.0 * D + 0.5 * std::min(amax * h * h, 0.1 * diag) + 0.5 * std::hypot(vx, vy) * h;
+        } else {
+            px = tr.last.x;
+            py = tr.last.y;
+            gate = std::max(5.0 * D, 0.08 * diag);
+        }
+        gate *= 1.0 + 0.5 * tr.misses;
+        int rank = tr.confirmed ? 0 : (na >= 3 ? 1 : 2);
         for (size_t bi = 0; bi < blobs.size(); bi++) {
-            double d = std::hypot(blobs[bi].cx_s - px, blobs[bi].cy_s - py);
-            double sr = blobs[bi].d_eq_s / std::max(1e-6, tr.d * scale);
-            if (d < gate && sr > 0.4 && sr < 2.5) pairs.push_back({d, bi, ti});
+            double bx = blobs[bi].cx_s / scale, by = blobs[bi].cy_s / scale;
+            double d = std::hypot(bx - px, by - py);
+            double sr = blobs[bi].d_minor_s / scale / std::max(1e-6, D);
+            if (d < gate && sr > 0.5 && sr < 2.0) pairs.push_back({rank, d / gate, bi, ti});
         }
     }
-    std::sort(pairs.begin(), pairs.end(), [](const Pair &a, const Pair &b) { return a.d < b.d; });
+    std::sort(pairs.begin(), pairs.end(), [](const Pair &a, const Pair &b) {
+        return a.rank != b.rank ? a.rank < b.rank : a.cost < b.cost;
+    });
     for (const auto &p : pairs) {
         if (blob_track[p.b] >= 0 || tracks[p.t].matched) continue;
         blob_track[p.b] = (int)p.t;
         tracks[p.t].matched = true;
     }
-    // new tracks for the rest (within max_balls, auto mode may follow more candidates)
-    size_t max_tr = color_known ? (size_t)cfg.max_balls : (size_t)std::max(cfg.max_balls, 8);
+    if (const char *dbg = std::getenv("GS_BALL_DEBUG"); dbg && dbg[0] == '2') {
+        for (size_t bi = 0; bi < blobs.size(); bi++) {
+            int ti = blob_track[bi];
+            std::fprintf(stderr, "f%ld blob %zu (%.0f,%.0f) d=%.1f el=%.2f -> track %d (n=%zu%s)\n", frame, bi,
+                         blobs[bi].cx_s / scale, blobs[bi].cy_s / scale, blobs[bi].d_minor_s / scale, blobs[bi].elong, ti,
+                         ti >= 0 ? tracks[(size_t)ti].arc.size() : 0, ti >= 0 && tracks[(size_t)ti].confirmed ? " ball" : "");
+        }
+    }
+    // new tentative tracks for the rest
     for (size_t bi = 0; bi < blobs.size(); bi++) {
-        if (blob_track[bi] >= 0 || tracks.size() >= max_tr) continue;
+        if (blob_track[bi] >= 0) continue;
+        if (tracks.size() >= kMaxTracks) {
+            // make room: the tentative track unseen longest, or the shortest
+            auto worst = tracks.end();
+            for (auto it = tracks.begin(); it != tracks.end(); ++it) {
+                if (it->confirmed || it->matched) continue;
+                if (worst == tracks.end() || it->misses > worst->misses ||
+                    (it->misses == worst->misses && it->arc.size() < worst->arc.size()))
+                    worst = it;
+            }
+            if (worst == tracks.end()) break;
+            for (auto &bt : blob_track)
+                if (bt > (int)(worst - tracks.begin())) bt--;
+            tracks.erase(worst);
+        }
         Track tr;
-        std::vector<bool> used(64, false);
-        for (const auto &o : tracks)
-            if (o.id >= 0 && o.id < 64) used[(size_t)o.id] = true;
-        int id = 0;
-        while (used[(size_t)id]) id++;
-        tr.id = id;
-        tr.x = blobs[bi].cx_s / scale;
-        tr.y = blobs[bi].cy_s / scale;
-        tr.t = t_s;
-        tr.d = blobs[bi].d_eq_s / scale;
         tr.matched = true;
         tracks.push_back(tr);
         blob_track[bi] = (int)tracks.size() - 1;
@@ -746,101 +952,131 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
 
     // measure and update
     keep_s.clear();
+    std::vector<size_t> newly;  // tracks confirmed this frame
     for (size_t bi = 0; bi < blobs.size(); bi++) {
         const Blob &b = blobs[bi];
-        cv::Rect r = b.box_s;
-        int m = (int)std::ceil(0.5 * b.d_eq_s) + 2;
-        r = cv::Rect(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m) & roi_s;
-        keep_s.push_back(r);
         int ti = blob_track[bi];
         if (ti < 0) continue;
         Track &tr = tracks[(size_t)ti];
-        bool fresh = tr.hits == 0;
         Meas ms = measure(bgr, b, tr.have_color ? &tr : nullptr);
-        double x = ms.ok ? ms.x : b.cx_s / scale, y = ms.ok ? ms.y : b.cy_s / scale;
-        if (!fresh) {
-            double h = t_s - tr.t;
-            if (h > 0) {
-                double vx = (x - tr.x) / h, vy = (y - tr.y) / h;
-                double k = tr.hits == 1 ? 1.0 : 0.7;
-                tr.vx += k * (vx - tr.vx);
-                tr.vy += k * (vy - tr.vy);
-            }
-        }
-        tr.x = x;
-        tr.y = y;
-        tr.t = t_s;
+        Pt p;
+        p.t = t_s;
+        p.frame = fidx;
+        p.x = ms.ok ? ms.x : b.cx_s / scale;
+        p.y = ms.ok ? ms.y : b.cy_s / scale;
+        p.d = ms.ok && ms.ratio < cfg.max_blur_ratio ? ms.d_perp : b.d_minor_s / scale;
+        p.m = ms;
+        bool fresh = tr.hits == 0;
+        tr.d_prev = tr.hits >= 3 ? tr.d : kNaN;
+        tr.d = fresh ? p.d : tr.d + 0.3 * (p.d - tr.d);
         tr.hits++;
         tr.misses = 0;
-        double d_prev = tr.hits >= 3 ? tr.d : kNaN;
-        double dmeas = ms.ok && ms.ratio < cfg.max_blur_ratio ? ms.d_perp : b.d_eq_s / scale;
-        tr.d = fresh ? dmeas : tr.d + 0.3 * (dmeas - tr.d);
         if (ms.ok && ms.ratio < 1.25 && !ms.at_edge) {
             if (!tr.have_color) tr.color = ms.color;
             else tr.color += 0.2f * (ms.color - tr.color);
             tr.have_color = true;
         }
-        tr.hist.push_back({t_s, x, y, dmeas});
-        {
-            // a bounce (falling, then rising) closes the flight segment
-            size_t n = tr.seg.size();
-            if (n >= 2 && tr.seg[n - 1].y - tr.seg[n - 2].y > 0.0 && y - tr.seg[n - 1].y < 0.0) {
-                rs_segment(tr.seg, bgr.rows);
-                tr.seg.erase(tr.seg.begin(), tr.seg.end() - 1);
-            }
-            if (!tr.seg.empty() && t_s - tr.seg.back().t > 0.2) tr.seg.clear();
-            tr.seg.push_back({t_s, x, y, dmeas});
-            if (tr.seg.size() > 400) tr.seg.erase(tr.seg.begin());
+        // the arc breaks where the parabola no longer explains the newest detection
+        // (a bounce, a catch, a hit); the new arc starts at it
+        bool brk = false;
+        if (tr.arc.size() >= 4 && tr.fit.ok) {
+            double e = std::hypot(tr.fit.x(t_s) - p.x, tr.fit.y(t_s) - p.y);
+            // a short arc's extrapolation is uncertain: its limit is wider
+            double k = tr.arc.size() < 8 ? 1.8 : 1.0;
+            brk = e > k * std::max({1.5, 3.0 * tr.fit.rms_px, 0.15 * tr.d});
         }
-        if (tr.hist.size() > 12) tr.hist.erase(tr.hist.begin());
-        if (!color_known) {
-            tr.blobs.push_back(b);
-            if (tr.blobs.size() > 12) tr.blobs.erase(tr.blobs.begin());
-            if (ballistic(tr)) {
-                // the colour is known: the candidates of other colours go, the ball is track 0
-                learn_color(tr);
-                for (auto &o : tracks)
-                    if (&o != &tr) o.dead = true;
-                tr.id = 0;
-            }
-            continue;  // nothing is reported before the colour is known
+        if (std::isfinite(tr.last.t) && tr.has_last && t_s - tr.last.t > 0.2) brk = true;
+        if (brk) {
+            if (tr.confirmed) rs_segment(tr.arc, bgr.rows);
+            tr.arc.clear();
         }
-        if (tr.hits < 2 || !ms.ok || tr.dead) continue;
+        tr.arc.push_back(p);
+        if (tr.arc.size() > kArcKeep) tr.arc.erase(tr.arc.begin());
+        tr.last = p;
+        tr.has_last = true;
+        tr.fit = tr.arc.size() >= 3 ? fit_points(tr.arc, kFitLast) : Parabola();
+        if (tr.confirmed || tr.arc.size() >= 3) {
+            cv::Rect r = b.box_s;
+            int m = (int)std::ceil(0.5 * b.d_eq_s) + 2;
+            keep_s.push_back(cv::Rect(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m) & roi_s);
+        }
+        if (!tr.confirmed && is_ball(tr) && !shadow_of_another(tr)) {
+            // a ball unseen for two frames or more is probably this one, found again
+            // elsewhere (thrown from where it was not seen resting): it ends and
+            // its number goes to the new one
+            for (auto &o : tracks)
+                if (&o != &tr && o.confirmed && o.misses >= 2) o.misses = 1 << 20;
+            int n_conf = 0;
+            for (const auto &o : tracks) n_conf += o.confirmed && o.misses < (1 << 20) ? 1 : 0;
+            if (n_conf < cfg.max_balls) {
+                std::vector<bool> used(64, false);
+                for (const auto &o : tracks)
+                    if (o.confirmed && o.misses < (1 << 20) && o.id >= 0 && o.id < 64) used[(size_t)o.id] = true;
+                int id = 0;
+                while (used[(size_t)id]) id++;
+                tr.id = id;
+                tr.confirmed = true;
+                tr.t_confirmed = t_s;
+                newly.push_back((size_t)ti);
+                // gravity's direction in the image, from the flights seen
+                double a = std::hypot(tr.fit.ax, tr.fit.ay);
+                if (a > 0.0) {
+                    double ux = tr.fit.ax / a, uy = tr.fit.ay / a;
+                    g_n++;
+                    gx += (ux - gx) / g_n;
+                    gy += (uy - gy) / g_n;
+                    double gn = std::hypot(gx, gy);
+                    gx /= gn;
+                    gy /= gn;
+                }
+                continue;  // its whole arc is reported below
+            }
+        }
+        if (!tr.confirmed) continue;
         BallObs o;
-        o.track = tr.id;
-        o.x_px = ms.x;
-        o.y_px = ms.y;
-        rs_correct(tr, bgr.rows, &o.x_px, &o.y_px);
-        double conf = 1.0;
-        bool good = true;
-        if (ms.at_edge) { conf *= 0.3; good = false; }
-        if (ms.ratio > cfg.max_blur_ratio) good = false;
-        conf *= std::max(0.2, 1.0 - 0.3 * std::max(0.0, ms.ratio - 1.2));
-        // the area and the width agree for an unoccluded ball (blur keeps both)
-        double cons = ms.d_area / ms.d_perp;
-        if (cons < 0.85 || cons > 1.2) { good = false; conf *= 0.5; }
-        if (ms.contrast < 30.0) { conf *= 0.5; }
-        // a sudden change of size: partly hidden or merged with something (its centre is off too)
-        if (std::isfinite(d_prev) && std::fabs(ms.d_perp / d_prev - 1.0) > 0.08 && ms.ratio < cfg.max_blur_ratio) {
-            good = false;
-            conf *= 0.2;
+        double vx = tr.fit.ok ? tr.fit.vx_at(t_s) : kNaN, vy = tr.fit.ok ? tr.fit.vy_at(t_s) : kNaN;
+        if (tr.arc.size() < 3 && tr.arc.size() >= 1) {
+            // just after a break: the chord from the detection before (contact in between)
+            vx = vy = kNaN;
         }
-        if (ms.d_perp < cfg.min_diameter_px || ms.d_perp > cfg.max_diameter_px) { good = false; conf *= 0.5; }
-        o.diameter_px = good ? ms.d_perp : kNaN;
-        o.confidence = std::min(1.0, std::max(0.05, conf));
-        out.push_back(o);
+        if (make_obs(tr, p, vx, vy, bgr.rows, o)) out.push_back(o);
     }
-    // tracks lost for a while end
-    int max_miss = std::max(3, (int)std::lround(0.25 / std::max(1e-3, dt)));
-    for (auto &tr : tracks)
+    // newly confirmed balls: their arc so far (the backlog) or just this frame
+    for (size_t ti : newly) {
+        Track &tr = tracks[ti];
+        size_t from = backlog ? 0 : tr.arc.size() - 1;
+        for (size_t i = from; i < tr.arc.size(); i++) {
+            const Pt &p = tr.arc[i];
+            BallObs o;
+            // the size test's sudden-change check against the running size then: not known; skip it
+            double dp = tr.d_prev;
+            tr.d_prev = kNaN;
+            if (make_obs(tr, p, tr.fit.vx_at(p.t), tr.fit.vy_at(p.t), bgr.rows, o)) out.push_back(o);
+            tr.d_prev = dp;
+        }
+    }
+    std::stable_sort(out.begin(), out.end(), [](const BallObs &a, const BallObs &b) {
+        return a.track != b.track ? a.track < b.track : a.t_s < b.t_s;
+    });
+    // tracks lost for a while end: balls after 0.25 s, candidates after two frames
+    int max_miss = std::max(3, (int)std::lround(0.25 / std::max(1e-4, dt)));
+    for (auto &tr : tracks) {
         if (!tr.matched) tr.misses++;
+        if (tr.confirmed && tr.misses == max_miss + 1) rs_segment(tr.arc, bgr.rows);  // its last flight
+    }
     tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
-                                [&](const Track &tr) { return tr.dead || tr.misses > max_miss; }),
+                                [&](const Track &tr) { return tr.misses > (tr.confirmed ? max_miss : 2); }),
                  tracks.end());
-    if (out.size() > (size_t)cfg.max_balls) out.resize((size_t)cfg.max_balls);
 
-    // backgrounds follow slow changes, not the balls: an unmasked update (SIMD,
-    // 8-bit source) with the balls' regions put back is ~5x cheaper than a masked one
+    // backgrounds follow slow changes (a time constant of 0.8 s), not the balls:
+    // an unmasked update (SIMD, 8-bit source) with the balls' regions put back is
+    // ~5x cheaper than a masked one
+    double rate = 1.0 - std::exp(-std::max(1e-4, dt) / 0.8);
+    // most of the frame changed (a fade, the light, an exposure step): catch up fast
+    if (moving_share > 0.25) rate = std::max(rate, 0.3);
+    // the first frames: a running mean (the first frame alone may hold anything)
+    if (frame < 16) rate = std::max(rate, 1.0 / (double)frame);
+
     cv::Rect roi_f(0, 0, bgr.cols, bgr.rows);
     std::vector<cv::Rect> keep_f;
     std::vector<cv::Mat> saved_s, saved_f;
@@ -851,8 +1087,8 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         saved_s.push_back(bg_small(r).clone());
         saved_f.push_back(bg_full(keep_f.back()).clone());
     }
-    cv::accumulateWeighted(small, bg_small, 0.04);
-    cv::accumulateWeighted(bgr, bg_full, 0.04);
+    cv::accumulateWeighted(small, bg_small, rate);
+    cv::accumulateWeighted(bgr, bg_full, rate);
     for (size_t i = keep_s.size(); i-- > 0;) {
         saved_s[i].copyTo(bg_small(keep_s[i]));
         saved_f[i].copyTo(bg_full(keep_f[i]));
@@ -867,12 +1103,8 @@ void BallDetector::process(const cv::Mat &bgr, double t_s, std::vector<BallObs> 
     p_->process(bgr, t_s, out);
 }
 
-bool BallDetector::color_known(double *hue_deg, double *sat_min, double *val_min) const
-{
-    if (hue_deg) *hue_deg = p_->hue;
-    if (sat_min) *sat_min = p_->sat_min;
-    if (val_min) *val_min = p_->val_min;
-    return p_->color_known;
-}
+void BallDetector::set_backlog(bool on) { p_->backlog = on; }
+
+double BallDetector::rolling_shutter_s_per_row() const { return p_->rs_k; }
 
 }  // namespace gs

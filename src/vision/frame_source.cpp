@@ -298,6 +298,9 @@ bool probe_video(const std::string &path, StreamProbe &out, std::string &err)
     out.width = st->codecpar->width;
     out.height = st->codecpar->height;
     out.codec = avcodec_get_name(st->codecpar->codec_id);
+    // the pixels' shape: the stream's or the codec's sample aspect ratio (0/1 when not stated)
+    AVRational sar = av_guess_sample_aspect_ratio(ic, const_cast<AVStream *>(st), nullptr);
+    if (sar.num > 0 && sar.den > 0) out.sample_aspect = av_q2d(sar);
     // Android writes the capture rate of slow motion into the container's metadata
     const AVDictionary *dicts[] = {st->metadata, ic->metadata};
     for (const AVDictionary *d : dicts) {

@@ -36,6 +36,7 @@ struct StreamProbe {
     int64_t n_frames = 0;         // frames the container announces (0 unknown)
     double duration_s = 0.0;      // 0 unknown
     int width = 0, height = 0;
+    double sample_aspect = 0.0;   // a pixel's width / height as the container states it (0 not stated)
     std::string codec;            // decoder name
 };
 
@@ -70,6 +71,7 @@ public:
     double stream_fps() const { return stream_fps_; }   // the stored stream's rate
     double time_scale() const { return scale_; }        // t = t_stream * time_scale
     double capture_fps_tag() const { return probe_.capture_fps; }
+    double sample_aspect() const { return probe_.sample_aspect; }  // 0: not stated
     int64_t frames_announced() const { return probe_.n_frames; }
     int64_t frames_read() const { return n_read_; }
     int64_t times_repaired() const { return n_repaired_; }

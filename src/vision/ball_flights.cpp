@@ -1,0 +1,441 @@
+// ball_flights.cpp - see ball_flights.hpp.
+#include "ball_flights.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+extern "C" {
+#include "gravscale/gs_time.h"
+}
+
+namespace gs {
+
+namespace {
+
+constexpr size_t kKeepObs = 20000;       // detections kept per track (1000 fps: 20 s)
+// Air drag changes a ball's acceleration along gravity by k v^2 (k = rho Cd A / 2m:
+// tennis and basket balls 0.02 /m); a flight may show up to this much of it
+constexpr double kDragMax_per_m = 0.05;
+constexpr double kTrendF = 12.0;         // F(2, n - 5) beyond p ~ 0.001: a trend, not noise
+constexpr double kTrendSlack = 0.06;     // and beyond drag by this share of the acceleration
+// the camera's blur is assumed known to +-0.6 px^2 in variance, the matte's edge to 0.5 %
+constexpr double kPsfVarUnc_px2 = 0.6;
+constexpr double kEdgeRel = 0.005;
+constexpr double kEdgePx = 0.15;
+// the widest lens assumed: a focal length of at least 0.35 x the frame's longer side
+constexpr double kFocalMinRel = 0.35;
+
+double median_of(std::vector<double> v)
+{
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Parabola fit_obs(const std::vector<BallObs> &pts)
+{
+    std::vector<TrackPoint> tp;
+    tp.reserve(pts.size());
+    for (const BallObs &o : pts) tp.push_back({o.t_s, o.x_px, o.y_px, 1.0});
+    return fit_parabola(tp);
+}
+
+bool debug() { return std::getenv("GS_BALL_DEBUG") != nullptr; }
+
+}  // namespace
+
+BallFlights::BallFlights(const BallFlightsOptions &o) : opt_(o) {}
+
+double BallFlights::frame_dt(const std::vector<BallObs> &pts) const
+{
+    std::vector<double> d;
+    for (size_t i = 1; i < pts.size(); i++)
+        if (pts[i].frame == pts[i - 1].frame + 1) d.push_back(pts[i].t_s - pts[i - 1].t_s);
+    double m = median_of(d);
+    return std::isfinite(m) && m > 0 ? m : 1.0 / 30.0;
+}
+
+void BallFlights::add(const BallObs &o)
+{
+    TrackState &ts = tracks_[o.track];
+    if (!ts.obs.empty() && !(o.t_s > ts.obs.back().t_s)) return;  // times increase per track
+    ts.obs.push_back(o);
+    if (ts.obs.size() > kKeepObs) ts.obs.erase(ts.obs.begin(), ts.obs.begin() + (long)(kKeepObs / 4));
+    // the open arc: a new detection the arc's parabola does not explain ends it
+    Arc &a = ts.arc;
+    bool brk = false;
+    if (!a.pts.empty()) {
+        double gap = o.t_s - a.pts.back().t_s;
+        if (gap > opt_.core.max_gap_s) brk = true;
+        if (!brk && a.pts.size() >= 4 && a.fit.ok) {
+            double e = std::hypot(a.fit.x(o.t_s) - o.x_px, a.fit.y(o.t_s) - o.y_px);
+            double d = std::isfinite(o.diameter_px) ? o.diameter_px : 10.0;
+            double k = a.pts.size() < 8 ? 1.8 : 1.0;  // a short arc's extrapolation is uncertain
+            brk = e > k * std::max({2.0, 4.0 * a.fit.rms_px, 0.15 * d});
+        }
+    }
+    if (brk) {
+        ts.breaks.push_back(o.t_s);
+        if (ts.breaks.size() > 4096) ts.breaks.erase(ts.breaks.begin(), ts.breaks.begin() + 1024);
+        close_arc(o.track, ts);
+        a.pts.clear();
+        a.fit = Parabola();
+    }
+    a.pts.push_back(o);
+    if (a.pts.size() >= 3) {
+        // the newest points predict (a bounce far back must not bend the prediction)
+        size_t n = std::min<size_t>(a.pts.size(), 30);
+        std::vector<BallObs> last(a.pts.end() - (long)n, a.pts.end());
+        a.fit = fit_obs(last);
+    }
+}
+
+// A closed arc with no apex inside (dropped from rest, entered falling, left
+// rising) is kept until the core has had its chance to report it.
+void BallFlights::close_arc(int track, TrackState &ts)
+{
+    Arc a = ts.arc;
+    if (a.pts.size() < (size_t)std::max<uint32_t>(opt_.core.min_samples, 4)) return;
+    // the last detection before a break is often the contact frame already: the
+    // parabola of the others decides
+    a.fit = fit_obs(a.pts);
+    if (!a.fit.ok) return;
+    double amag = std::hypot(a.fit.ax, a.fit.ay);
+    if (!(amag > 0)) return;
+    double ux = a.fit.ax / amag, uy = a.fit.ay / amag;
+    double dt = frame_dt(a.pts);
+    double v_down = a.fit.vx * ux + a.fit.vy * uy;
+    double t_apex = a.fit.t0_s - v_down / amag;
+    double t0 = a.pts.front().t_s, t1 = a.pts.back().t_s;
+    bool apex_inside = t_apex > t0 + 1.5 * dt && t_apex < t1 - 1.5 * dt;
+    if (debug())
+        std::fprintf(stderr, "arc track %d %.3f-%.3f n=%zu a=%.0f apex %.3f %s\n", track, t0, t1, a.pts.size(), amag,
+                     t_apex, apex_inside ? "inside (core)" : "outside: pending");
+    if (apex_inside) return;
+    // a free fall at all (as the core's gate): along gravity within 45 degrees and a
+    // size of [size_min / 2, 2 size_max] under g for the arc's diameter
+    std::vector<double> ds;
+    for (const BallObs &o : a.pts)
+        if (std::isfinite(o.diameter_px)) ds.push_back(o.diameter_px);
+    double d = median_of(ds);
+    if (!(uy > std::cos(M_PI / 4.0)) || !std::isfinite(d)) return;
+    double size_m = opt_.g_m_s2 * d / amag;
+    if (size_m < 0.5 * opt_.core.size_min_m || size_m > 2.0 * opt_.core.size_max_m) return;
+    ts.pending.push_back(a);
+}
+
+FlightSize BallFlights::measure(const std::vector<BallObs> &pts, const Parabola &fit, double a_px_s2)
+{
+    FlightSize fs;
+    fs.n = pts.size();
+    if (!fit.ok || pts.size() < 4) return fs;
+    double amag = std::hypot(fit.ax, fit.ay);
+    double gx = amag > 0 ? fit.ax / amag : 0.0, gy = amag > 0 ? fit.ay / amag : 1.0;
+    // ---- size
+    double dt = frame_dt(pts);
+    std::vector<MomentObs> mo;
+    std::vector<double> widths;
+    for (const BallObs &o : pts) {
+        if (std::isfinite(o.diameter_px)) widths.push_back(o.diameter_px);
+        if (!std::isfinite(o.sxx)) continue;
+        MomentObs m;
+        m.sxx = o.sxx;
+        m.syy = o.syy;
+        m.sxy = o.sxy;
+        m.vx = fit.vx_at(o.t_s);
+        m.vy = fit.vy_at(o.t_s);
+        m.rx = o.x_px - 0.5 * (opt_.frame_w - 1);
+        m.ry = o.y_px - 0.5 * (opt_.frame_h - 1);
+        mo.push_back(m);
+        if (std::getenv("GS_BALL_DEBUG_MOMENTS"))
+            std::fprintf(stderr, "  m t=%.3f v=(%.0f,%.0f) r=(%.0f,%.0f) sxx=%.1f syy=%.1f sxy=%.1f d=%.1f dk=%.2f psf2=%.2f\n", o.t_s, m.vx, m.vy,
+                         m.rx, m.ry, m.sxx, m.syy, m.sxy, o.diameter_px, o.diameter_kurt_px, o.psf_var_px2);
+    }
+    // the camera's blur, measured: the 4th moment across the motion tells a
+    // Gaussian blur's variance from the disc's (pooled over the clip's detections)
+    for (const BallObs &o : pts)
+        if (std::isfinite(o.psf_var_px2) && std::isfinite(o.sxx)) psf_seen_.push_back(o.psf_var_px2);
+    double psf_sigma = opt_.psf_sigma_px, psf_unc = kPsfVarUnc_px2;
+    if (psf_seen_.size() >= 8) {
+        double v = median_of(psf_seen_);
+        std::vector<double> dev;
+        for (double x : psf_seen_) dev.push_back(std::fabs(x - v));
+        double spread = 1.4826 * median_of(dev);
+        // never below the configured blur: the matte's floor clips the blur's tails,
+        // which makes this estimate low where the blur is small
+        v = std::min(std::max(v, opt_.psf_sigma_px * opt_.psf_sigma_px), 25.0);
+        psf_sigma = std::sqrt(v);
+        psf_unc = std::max(0.25, 2.0 * spread / std::sqrt((double)psf_seen_.size()));
+    }
+    double fmin = kFocalMinRel * std::max(opt_.frame_w, opt_.frame_h);
+    SizeFit sf = fit_size(mo, psf_sigma, 1.05 * dt * dt / 12.0, fmin > 0 ? 1.0 / (fmin * fmin) : 0.0);
+    if (sf.ok) {
+        fs.aspect = sf.aspect;
+        fs.aspect_se = sf.aspect_se;
+        // the pixels' shape is the camera's: pooled over the flights seen
+        double se = std::max(sf.aspect_se, 0.01);
+        aspect_w_ += 1.0 / (se * se);
+        aspect_sum_ += sf.aspect / (se * se);
+        double pooled = aspect_sum_ / aspect_w_, pooled_se = std::sqrt(1.0 / aspect_w_);
+        bool square = opt_.square_pixels || std::fabs(pooled - 1.0) <= std::max(0.05, 3.0 * pooled_se);
+        double d, d_se;
+        if (square && sf.d_sq_px > 0) {
+            d = sf.d_sq_px;
+            d_se = sf.d_sq_se;
+        } else {
+            // along gravity: the non-square model's diameter in that direction
+            d = size_along(sf, gx, gy);
+            d_se = std::sqrt(gx * gx * sf.dx_se * sf.dx_se + gy * gy * sf.dy_se * sf.dy_se);
+            fs.along_gravity = true;
+        }
+        // what the fit cannot see: the camera's blur (known to kPsfVarUnc) and the matte's edge
+        double sys_psf = 8.0 * psf_unc / d;
+        double sys_edge = kEdgeRel * d + kEdgePx;
+        fs.psf_sigma_px = psf_sigma;
+        fs.size_px = d;
+        fs.size_se_px = std::sqrt(d_se * d_se + sys_psf * sys_psf + sys_edge * sys_edge);
+        fs.ok = std::isfinite(d) && d > 0;
+    } else if (widths.size() >= 3) {
+        // too few clean mattes for the fit: the widths across the motion
+        double d = median_of(widths);
+        std::vector<double> dev;
+        for (double w : widths) dev.push_back(std::fabs(w - d));
+        double se = 1.4826 * median_of(dev) * 1.25 / std::sqrt((double)widths.size());
+        double sys_psf = 8.0 * psf_unc / d, sys_edge = kEdgeRel * d + kEdgePx;
+        fs.size_px = d;
+        fs.size_se_px = std::sqrt(se * se + sys_psf * sys_psf + sys_edge * sys_edge + 0.0004 * d * d);
+        fs.ok = true;
+    }
+    // ---- geometry: the positions along gravity, parabola against quartic
+    std::vector<double> t, u;
+    for (const BallObs &o : pts) {
+        t.push_back(o.t_s);
+        u.push_back(o.x_px * gx + o.y_px * gy);
+    }
+    // A rolling shutter shows a ball at y + k v (y - rows/2): its image accelerates
+    // by a (1 + 3 k v_down), so the acceleration changes by 3 k dv along the flight
+    // and a window whose mean v_down is not 0 is biased by 3 k mean(v_down). k is
+    // the detector's estimate (positions already corrected: a quarter of a frame
+    // time per frame height left) or, without one, up to a frame time per height.
+    double k_bound = (rs_k_ != 0.0 ? 0.25 : 1.0) * dt / std::max(1.0, opt_.frame_h);
+    double v0 = fit.vx_at(pts.front().t_s) * gx + fit.vy_at(pts.front().t_s) * gy;
+    double v1 = fit.vx_at(pts.back().t_s) * gx + fit.vy_at(pts.back().t_s) * gy;
+    double vmean = 0.0;
+    for (const BallObs &o : pts) vmean += (fit.vx_at(o.t_s) * gx + fit.vy_at(o.t_s) * gy) / (double)pts.size();
+    fs.a_sys_rel = 3.0 * k_bound * std::fabs(vmean);
+    double t_apex = amag > 0 ? fit.t0_s - (fit.vx * gx + fit.vy * gy) / amag : NAN;
+    TrendTest tt = trend_test(t, u, t_apex);
+    if (tt.ok) {
+        double s0 = std::pow(std::hypot(fit.vx_at(pts.front().t_s), fit.vy_at(pts.front().t_s)), 2);
+        double s1 = std::pow(std::hypot(fit.vx_at(pts.back().t_s), fit.vy_at(pts.back().t_s)), 2);
+        double a = a_px_s2 > 0 ? a_px_s2 : amag;
+        // drag's share of the acceleration: k v^2 / g with v = v_px g / a, from both ends
+        // (the shutter's full bound: an estimate from a few short flights is not sure enough to lean on)
+        double k_full = dt / std::max(1.0, opt_.frame_h);
+        double allow = kDragMax_per_m * opt_.g_m_s2 * (s0 + s1) / (a * a) + 3.0 * k_full * std::fabs(v1 - v0) +
+                       kTrendSlack;
+        fs.trend_change = tt.a_change_rel;
+        fs.trend_f = tt.f_stat;
+        fs.trend_allow = allow;
+        fs.not_planar = tt.f_stat > kTrendF && tt.a_change_rel > allow;
+        // the camera's geometry is the clip's: once most flights tested showed it
+        // (two at least), the later ones are not trusted either, however short
+        n_tested_++;
+        if (fs.not_planar) n_not_planar_++;
+        if (n_not_planar_ >= 2 && 2 * n_not_planar_ >= n_tested_) fs.not_planar = true;
+        fs.trend_rms4_px = tt.rms4_px;
+        fs.a_apex_px_s2 = tt.a_apex_px_s2;
+        fs.a_apex_se_px_s2 = tt.a_apex_se_px_s2;
+    }
+    if (debug())
+        std::fprintf(stderr, "size: psf %.2f px, n=%zu moments=%zu used=%zu dx=%.2f dy=%.2f sq=%.2f (se %.2f) aspect=%.3f+-%.3f s=%.2e -> %s %.2f+-%.2f px; trend %.3f (allow %.3f) F=%.1f%s\n",
+                     fs.psf_sigma_px, pts.size(), mo.size(), sf.n_used, sf.dx_px, sf.dy_px, sf.d_sq_px, sf.d_sq_se, sf.aspect,
+                     sf.aspect_se, sf.s_s2, fs.along_gravity ? "along g" : "square", fs.size_px, fs.size_se_px,
+                     fs.trend_change, fs.trend_allow, fs.trend_f, fs.not_planar ? " NOT PLANAR" : "");
+    if (debug())
+        std::fprintf(stderr, "      rolling-shutter bias bound on a: %.3f; a at the apex %.1f +- %.1f, quartic rms %.2f\n",
+                     fs.a_sys_rel, fs.a_apex_px_s2, fs.a_apex_se_px_s2, fs.trend_rms4_px);
+    measured_.push_back(fs);
+    return fs;
+}
+
+void BallFlights::judge(gs_ev_jump *j)
+{
+    auto it = tracks_.find((int)j->track);
+    if (it == tracks_.end()) return;
+    TrackState &ts = it->second;
+    double t0 = gs_time_s_of_us(j->t_takeoff_us), t1 = gs_time_s_of_us(j->t_land_us);
+    if (!std::isfinite(t0) || !std::isfinite(t1)) return;
+    ts.core_windows.emplace_back(t0, t1);
+    std::vector<BallObs> in;
+    for (const BallObs &o : ts.obs)
+        if (o.t_s > t0 && o.t_s < t1) in.push_back(o);
+    Parabola fit = fit_obs(in);
+    FlightSize fs = measure(in, fit, j->a_px_s2);
+    // One parabola must explain the flight's detections: where the track's own
+    // parabola broke inside the window (a hand caught or pushed the ball: a dribble)
+    // with detections on both sides, the core's fit joins two motions
+    if (j->accepted) {
+        for (double tb : ts.breaks) {
+            if (!(tb > t0 && tb < t1)) continue;
+            size_t before = 0, after = 0;
+            for (const BallObs &o : in) (o.t_s < tb ? before : after)++;
+            if (before >= 3 && after >= 3) {
+                if (debug()) std::fprintf(stderr, "      the track's parabola breaks at %.3f inside the flight\n", tb);
+                j->accepted = false;
+                j->reason = GS_REJ_LARGE_RESIDUAL;
+                break;
+            }
+        }
+    }
+    // ... and a contact at an end leaves the others' parabola, the core's fit
+    // through it having another acceleration
+    if (j->accepted && in.size() >= 6 && fs.ok) {
+        std::vector<TrackPoint> tp;
+        for (const BallObs &o : in) tp.push_back({o.t_s, o.x_px, o.y_px, 1.0});
+        std::vector<bool> inl;
+        Parabola r = ransac_parabola(tp, std::max(1.0, 0.06 * fs.size_px), 300, inl, 1);
+        size_t n_in = (size_t)std::count(inl.begin(), inl.end(), true);
+        double ar = std::hypot(r.ax, r.ay);
+        if (r.ok && n_in >= 5 && n_in < in.size() && ar > 0 &&
+            std::fabs(ar / j->a_px_s2 - 1.0) > 0.05 + 3.0 * std::hypot(r.ax_se, r.ay_se) / ar) {
+            if (debug())
+                std::fprintf(stderr, "      the core's a %.0f, its inliers' %.0f (%zu of %zu): not one parabola\n",
+                             j->a_px_s2, ar, n_in, in.size());
+            j->accepted = false;
+            j->reason = GS_REJ_LARGE_RESIDUAL;
+        }
+    }
+    if (fs.ok && std::isfinite(j->q_m_per_px)) {
+        j->size_px = fs.size_px;
+        j->height_m = fs.size_px * j->q_m_per_px;
+        double ra = j->a_px_se_s2 / j->a_px_s2, rs = fs.size_se_px / fs.size_px, rr = fs.a_sys_rel / std::sqrt(3.0);
+        j->height_se_m = j->height_m * std::sqrt((std::isfinite(ra) ? ra * ra : 0.0) + rs * rs + rr * rr);
+        if (j->accepted && (j->height_m < opt_.core.size_min_m || j->height_m > opt_.core.size_max_m)) {
+            j->accepted = false;
+            j->reason = GS_REJ_IMPLAUSIBLE_A;
+        }
+    }
+    // The core's residual test assumes a parabola; a long, fast flight of a light
+    // ball keeps a smooth trend from air drag (or a rolling shutter) that the test
+    // reads as noise. When the quartic follows the positions within the core's
+    // limit and the trend is one drag and the shutter can make, the flight stands
+    // (its mean acceleration: over an arc about its apex, drag's and the shutter's
+    // changes, odd in the vertical velocity, cancel to first order).
+    if (!j->accepted && j->reason == GS_REJ_LARGE_RESIDUAL && fs.ok && !fs.not_planar && in.size() >= 10 &&
+        fs.trend_rms4_px <= opt_.core.max_rms_rel * fs.size_px && std::isfinite(j->height_m)) {
+        j->rms_px = fs.trend_rms4_px;
+        bool in_range = j->height_m >= opt_.core.size_min_m && j->height_m <= opt_.core.size_max_m;
+        j->accepted = in_range;
+        j->reason = in_range ? GS_REJ_NONE : GS_REJ_IMPLAUSIBLE_A;
+    }
+    if (fs.not_planar && j->accepted) {
+        j->accepted = false;
+        j->reason = GS_REJ_NOT_PLANAR;
+    }
+}
+
+bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
+{
+    // the first and last detections may be contact (release, impact): out when they
+    // leave the others' parabola
+    std::vector<BallObs> pts = a0.pts;
+    Parabola fit = fit_obs(pts);
+    for (int end = 0; end < 2 && pts.size() > 5; end++) {
+        std::vector<BallObs> rest(pts.begin() + (end == 0 ? 1 : 0), pts.end() - (end == 1 ? 1 : 0));
+        Parabola f2 = fit_obs(rest);
+        const BallObs &o = end == 0 ? pts.front() : pts.back();
+        double e = std::hypot(f2.x(o.t_s) - o.x_px, f2.y(o.t_s) - o.y_px);
+        if (f2.ok && e > std::max(1.0, 4.0 * f2.rms_px)) {
+            pts = rest;
+            fit = f2;
+        }
+    }
+    if (!fit.ok) return false;
+    double amag = std::hypot(fit.ax, fit.ay);
+    if (!(amag > 0)) return false;
+    std::memset(j, 0, sizeof *j);
+    j->track = (uint32_t)track;
+    double dt = frame_dt(pts);
+    double t0 = pts.front().t_s, t1 = pts.back().t_s;
+    j->t_takeoff_us = gs_time_us_of_s(t0);
+    j->t_land_us = gs_time_us_of_s(t1);
+    j->flight_time_s = t1 - t0;
+    double ux = fit.ax / amag, uy = fit.ay / amag;
+    double v_down = fit.vx * ux + fit.vy * uy;
+    j->t_apex_us = gs_time_us_of_s(fit.t0_s - v_down / amag);
+    j->a_px_s2 = amag;
+    j->a_px_se_s2 = std::hypot(fit.ax * fit.ax_se, fit.ay * fit.ay_se) / amag;
+    j->g_dir_deg = std::atan2(fit.ax, fit.ay) * 180.0 / M_PI;
+    j->q_m_per_px = opt_.g_m_s2 / amag;
+    j->jump_height_m = NAN;  // no take-off from the ground: a ball released or entering
+    j->takeoff_velocity_m_s = NAN;
+    j->n_samples = (uint32_t)pts.size();
+    j->n_outliers = (uint32_t)(a0.pts.size() - pts.size());
+    j->rms_px = fit.rms_px;
+    j->height_m = j->height_se_m = j->size_px = NAN;
+    FlightSize fs = measure(pts, fit, amag);
+    if (fs.ok) {
+        j->size_px = fs.size_px;
+        j->height_m = fs.size_px * j->q_m_per_px;
+        double ra = j->a_px_se_s2 / amag, rs = fs.size_se_px / fs.size_px, rr = fs.a_sys_rel / std::sqrt(3.0);
+        j->height_se_m = j->height_m * std::sqrt(ra * ra + rs * rs + rr * rr);
+    }
+    // the core's rules, then the geometry
+    double max_gap = 0.0;
+    for (size_t i = 1; i < pts.size(); i++) max_gap = std::max(max_gap, pts[i].t_s - pts[i - 1].t_s);
+    const gs_core_config &c = opt_.core;
+    if (pts.size() < c.min_samples || j->flight_time_s < c.min_flight_s)
+        j->reason = GS_REJ_FEW_SAMPLES;
+    else if (max_gap > c.max_gap_s)
+        j->reason = GS_REJ_GAP;
+    else if (!fs.ok)
+        j->reason = GS_REJ_NO_SIZE;
+    else if (fit.rms_px > c.max_rms_rel * fs.size_px)
+        j->reason = GS_REJ_LARGE_RESIDUAL;
+    else if (!(std::hypot(j->a_px_se_s2 / amag, fs.a_sys_rel) <= c.max_a_se_rel))
+        j->reason = GS_REJ_UNCERTAIN_A;
+    else if (j->height_m < c.size_min_m || j->height_m > c.size_max_m)
+        j->reason = GS_REJ_IMPLAUSIBLE_A;
+    else if (fs.not_planar)
+        j->reason = GS_REJ_NOT_PLANAR;
+    j->accepted = j->reason == GS_REJ_NONE;
+    if (pts.size() < 2u * c.min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
+    (void)dt;
+    return true;
+}
+
+void BallFlights::take_pending(double t_now_s, bool flush, std::vector<gs_ev_jump> &out)
+{
+    const double wait_s = opt_.core.landing_latency_s + 0.3;
+    for (auto &kv : tracks_) {
+        TrackState &ts = kv.second;
+        if (flush && ts.arc.pts.size() >= 2) {
+            close_arc(kv.first, ts);
+            ts.arc.pts.clear();
+        }
+        for (size_t i = 0; i < ts.pending.size();) {
+            const Arc &a = ts.pending[i];
+            double t0 = a.pts.front().t_s, t1 = a.pts.back().t_s;
+            if (!flush && t1 > t_now_s - wait_s) {
+                i++;
+                continue;
+            }
+            // the core reported it (its flight covers half the arc or more): nothing to add
+            bool core_has = false;
+            for (const auto &w : ts.core_windows) {
+                double ov = std::min(w.second, t1) - std::max(w.first, t0);
+                if (ov > 0.5 * (t1 - t0)) core_has = true;
+            }
+            gs_ev_jump j;
+            if (!core_has && flight_from_arc(kv.first, a, &j)) out.push_back(j);
+            ts.pending.erase(ts.pending.begin() + (long)i);
+        }
+    }
+}
+
+}  // namespace gs
