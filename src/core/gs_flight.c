@@ -871,18 +871,6 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         f->up_y = -r.ay_px_s2 / r.a_px_s2;
     }
     uint64_t L = f->fl_first, R = f->fl_last;
-    /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
-     * holds a contiguous range; the contact samples lie between L and the newest and
-     * are held, so L tells for all of them.) */
-    bool refine = IS_RIGID(f) && held(f, L);  /* a body's boundaries are its feet's */
-    gs_real sig = fit_sigma(f, &r);
-    gs_real pen = DROP_PENALTY * sig * sig;
-    uint64_t lo, hi;  /* the outermost contact samples */
-    int64_t T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
-    int64_t T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
-    DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
-        (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
-        (long long)T0, (long long)T1, r.a_px_s2);
     /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
     float floor_off = NAN, floor_on = NAN, floor_before = NAN;
     int64_t F0 = GS_T_NONE, F1 = GS_T_NONE;
@@ -891,7 +879,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     if (f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(&r);
-        int64_t c0 = T0 != GS_T_NONE ? T0 : t_at(f, L), c1 = T1 != GS_T_NONE ? T1 : t_at(f, R);
+        int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
 
             F0 = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &floor_off);
@@ -914,6 +902,18 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         fell = F0 != GS_T_NONE ? gs_feet_low_px(&f->feet) < floor_off - d_px - GS_FEET_SINK_REL * (float)gate_size(f, L)
                                : gs_feet_sank_since(&f->feet, c0);
     }
+    /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
+     * holds a contiguous range; the contact samples lie between L and the newest and
+     * are held, so L tells for all of them.) */
+    bool refine = held(f, L) && !(F0 != GS_T_NONE && F1 != GS_T_NONE);  /* a body's are its feet's where seen */
+    gs_real sig = fit_sigma(f, &r);
+    gs_real pen = DROP_PENALTY * sig * sig;
+    uint64_t lo, hi;  /* the outermost contact samples */
+    int64_t T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
+    int64_t T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
+    DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
+        (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
+        (long long)T0, (long long)T1, r.a_px_s2);
     /* with the feet's times: the flight and the nearly free frames beside it (the push-off's
      * last tens of ms, when the ground already bears less than the weight; the first of the
      * landing) as far as the parabola explains them */
