@@ -76,6 +76,7 @@
 #define FEET_FREE_EDGE_US 50000      /* the fit takes samples this far past the feet's boundaries (30-60 ms of push-off below body weight) */
 #define FALL_FLOOR_REL   0.1f         /* landed this x size below the floor it left (a box, 20-60 cm): a fall, not a jump; less is a jump toward the camera */
 #define FEET_WAIT_US     100000       /* after the COM's landing, wait this long for feet still in the air */
+#define STRIDE_REL       GS_R(0.5)    /* a short COM-timed flight moving across faster than this x size per second is a stride */
 #define CONTACT_MAX_US   1000000      /* a rebound leaves the ground within this of the landing (drop jumps: 0.2-0.9 s) */
 #define DEPTH_TOL_REL    GS_R(0.015)  /* standing at the flight's place: its floor row within this x size */
 #define COM_MISMATCH_REL GS_R(0.04)   /* the COM at landing this x size off its take-off height: flagged */
@@ -445,6 +446,17 @@ static bool gravity_agrees(const gs_flight *f, const gs_fit_result *r)
     gs_real lim = GRAV_DIR_SE_K * r->a_se_px_s2 / r->a_px_s2 + GRAV_DIR_MIN_DEG * GS_PI / GS_R(180.0);
     if (!(lim < GS_R(1.5))) return !(lim == lim) ? false : true;  /* SE unknown: no; SE huge: no test */
     return cosang >= (gs_real)GS_COS(lim);
+}
+
+/* A few frames' flight the feet did not time, of a body travelling across the image: a
+ * running stride, whose limbs swing in depth at speed, so its keypoint COM is no ballistic
+ * body's (a jump in place drifts a few cm/s; a stride travels metres a second) */
+static bool running_stride(const gs_flight *f, const gs_fit_result *r, uint32_t n, bool feet, gs_real size_px)
+{
+    if (IS_RIGID(f) || feet || n >= 2u * f->cfg->min_samples || !finite_r(size_px)) return false;
+    gs_real gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
+    gs_real v_across = GS_FABSR(r->vx_px_s * gy - r->vy_px_s * gx);  /* perpendicular to gravity */
+    return v_across > STRIDE_REL * size_px;
 }
 
 /* sample s into the running fit */
@@ -1043,7 +1055,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
             j->reason = GS_REJ_NO_SIZE;
         else if (finite_r(gsize) && fr.rms_px > (gs_real)f->cfg->max_rms_rel * gsize)
             j->reason = GS_REJ_LARGE_RESIDUAL;
-        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)f->cfg->max_a_se_rel))
+        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)f->cfg->max_a_se_rel) || running_stride(f, &fr, n_in, feet, gsize))
             j->reason = GS_REJ_UNCERTAIN_A;
         else if (!gravity_agrees(f, &fr))
             j->reason = GS_REJ_GRAVITY_DIR;
