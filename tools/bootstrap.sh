@@ -31,6 +31,7 @@ fi
 bash tools/setup_cam.sh      # GStreamer base plugins (videotestsrc) and libcamera-dev for gravscale cam
 bash tools/fetch_unity.sh
 bash tools/fetch_models.sh   # BlazePose: npm package -> ONNX in models/ (checksummed)
+bash tools/fetch_engine.sh   # OpenVINO for the pose networks: PyPI wheel into .venv-engine/ (else OpenCV DNN)
 
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build "$BUILD_DIR" -j "$(nproc)"
