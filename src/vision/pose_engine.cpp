@@ -63,16 +63,6 @@ public:
 };
 
 #if GS_HAVE_OPENVINO
-// The CPUs this process may run on (taskset, cgroups' cpusets), at least 1.
-int allowed_cpus()
-{
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    if (sched_getaffinity(0, sizeof set, &set) != 0) return 1;
-    int n = CPU_COUNT(&set);
-    return n > 0 ? n : 1;
-}
-
 class OpenVinoNet : public PoseNet {
 public:
     ov::CompiledModel model;
@@ -107,6 +97,15 @@ public:
 #endif
 
 }  // namespace
+
+int allowed_cpus()
+{
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) != 0) return 1;
+    int n = CPU_COUNT(&set);
+    return n > 0 ? n : 1;
+}
 
 std::unique_ptr<PoseNet> pose_net_load(PoseEngine e, const std::string &path, int threads, std::string &err)
 {

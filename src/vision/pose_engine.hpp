@@ -34,6 +34,9 @@ public:
     virtual void run(const cv::Mat &blob, const std::vector<std::string> &names, std::vector<cv::Mat> &outs) = 0;
 };
 
+// The CPUs this process may run on (taskset, cpusets), at least 1.
+int allowed_cpus();
+
 // The network in path run by engine e (not automatic) on threads CPU threads
 // (0: the engine's default, the CPUs this process may use). nullptr with err
 // set when it cannot be loaded or e is not built. OpenCV's thread count is
