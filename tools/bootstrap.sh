@@ -13,11 +13,13 @@ SUDO=""
 # OpenCV and libavformat for the video command (tests render clips with them);
 # python3-opencv, python3-venv and opencv-doc for the pose models' converter and its test;
 # clang with its sanitizer/libFuzzer runtime and llvm-symbolizer for tests/fuzz/run.sh;
-# the arm-none-eabi cross compiler with newlib nano and QEMU for the Cortex-M4 firmware check
+# the arm-none-eabi cross compiler with newlib nano and QEMU for the Cortex-M4 firmware check;
+# valgrind (callgrind) for bench_core's instruction counts, python3-numpy for tools/bench_paper.py
 pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev
       python3-opencv python3-venv opencv-doc
       clang libclang-rt-14-dev llvm-14
-      gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm)
+      gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
+      valgrind python3-numpy)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

@@ -11,6 +11,19 @@
  * (numerically) a combination of the previous ones: the design is singular. */
 #define GS_FIT_SINGULAR_REL (sizeof(gs_real) < sizeof(double) ? GS_R(1e-5) : GS_R(1e-9))
 
+/* A robust fit passes over its window some twenty times (medians, reweightings,
+ * candidate starts): where the build optimises for speed, its first GS_FIT_CACHE
+ * samples are unpacked once on the stack with their last residuals, medians select
+ * from a buffer, and LMS candidates that cannot win are dropped by a count. Where
+ * it optimises for size (-Os: the firmware, whose code budget is full) none of
+ * that is compiled: the same results from the compact code (samples read from the
+ * ring, medians by counting passes); QEMU's lines equal the host float build's. */
+#ifdef __OPTIMIZE_SIZE__
+#define GS_FIT_FAST 0
+#else
+#define GS_FIT_FAST 1
+#endif
+
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
 #define GS_FIT_TUKEY_C GS_R(4.685)
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
@@ -57,10 +70,12 @@ static gs_real fit_tau(int64_t t_us, int64_t t0_us, gs_real tscale_us)
     return gs_time_span_us(t_us, t0_us) / tscale_us;
 }
 
-/* Entry j of row k of the augmented factor [R | zx zy]: columns 0-2 are R's, 3 and 4 the right-hand sides. */
-static gs_real *aug_entry(gs_fit *f, int k, int j)
+/* Rotate pair (e, v) by (c, s): the Givens step of one entry of [R | zx zy]. */
+static void rot(gs_real *e, gs_real *v, gs_real c, gs_real s)
 {
-    return j < 3 ? &f->r[rix(k, j)] : j == 3 ? &f->zx[k] : &f->zy[k];
+    gs_real rkj = *e;
+    *e = c * rkj + s * *v;
+    *v = c * *v - s * rkj;
 }
 
 /* Rotate the weighted row (1, tau, tau^2 | x, y) into [R | zx zy]; w > 0 and all values finite. */
@@ -74,21 +89,25 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
     v[2] = sw * tau * tau;
     v[3] = sw * (gs_real)x_px;
     v[4] = sw * (gs_real)y_px;
+#if GS_FIT_FAST
+#pragma GCC unroll 3 /* hosts: every index constant, no branch per entry (the firmware keeps the loops) */
+#endif
     for (k = 0; k < 3; k++) {
-        gs_real a = f->r[rix(k, k)];
+        gs_real *rk = &f->r[rix(k, k)]; /* row k of R, packed: R(k, j) at rk[j - k] */
+        gs_real a = rk[0];
         gs_real b = v[k];
-        gs_real rho, c, s;
+        gs_real rho, c, sn;
         if (b == GS_R(0.0)) {
             continue;
         }
         rho = sqrt(a * a + b * b);
         c = a / rho;
-        s = b / rho;
+        sn = b / rho;
+#if GS_FIT_FAST
+#pragma GCC unroll 5
+#endif
         for (j = k; j < 5; j++) {
-            gs_real *e = aug_entry(f, k, j);
-            gs_real rkj = *e;
-            *e = c * rkj + s * v[j];
-            v[j] = c * v[j] - s * rkj;
+            rot(j < 3 ? &rk[j - k] : j == 3 ? &f->zx[k] : &f->zy[k], &v[j], c, sn);
         }
     }
     /* What is left of the row after eliminating its basis part is its residual. */
@@ -231,18 +250,8 @@ typedef struct {
     float w;        /* prior weight (> 0); 0 marks a cached sample the fits skip */
 } gs_fsamp;
 
-/* A robust fit passes over its window some twenty times (medians, reweightings,
- * candidate starts): where the build optimises for speed, its first GS_FIT_CACHE
- * samples are unpacked once on the stack with their last residuals, medians select
- * from a buffer, and LMS candidates that cannot win are dropped by a count. Where
- * it optimises for size (-Os: the firmware, whose code budget is full) none of
- * that is compiled: the same results from the compact code (samples read from the
- * ring, medians by counting passes); QEMU's lines equal the host float build's. */
-#ifdef __OPTIMIZE_SIZE__
-#define GS_FIT_FAST 0
-#else
-#define GS_FIT_FAST 1
-#endif
+/* Window samples unpacked on the stack by a fast build (1.5 KB with their residuals
+ * and keys where gs_real is float, 9 KB in double) */
 #define GS_FIT_CACHE (GS_REAL_IS_FLOAT ? 64u : 256u)
 
 typedef struct {
