@@ -30,21 +30,6 @@ extern "C" {
 void setUp(void) {}
 void tearDown(void) {}
 
-namespace {
-
-const char kGym[] = "/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4";
-
-std::vector<cv::Mat> gym_frames()
-{
-    std::vector<cv::Mat> v;
-    cv::VideoCapture cap(std::string(GS_SHARED_DIR) + kGym);
-    cv::Mat f;
-    while (cap.read(f)) v.push_back(f.clone());
-    return v;
-}
-
-}  // namespace
-
 static void test_engine_names(void)
 {
     gs::PoseEngine e = gs::PoseEngine::opencv;
@@ -81,6 +66,21 @@ static void test_engine_names(void)
 }
 
 #if GS_HAVE_OPENVINO
+namespace {
+
+const char kGym[] = "/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4";
+
+std::vector<cv::Mat> gym_frames()
+{
+    std::vector<cv::Mat> v;
+    cv::VideoCapture cap(std::string(GS_SHARED_DIR) + kGym);
+    cv::Mat f;
+    while (cap.read(f)) v.push_back(f.clone());
+    return v;
+}
+
+}  // namespace
+
 static void test_openvino_keypoints_equal_opencv_on_the_gym_jump(void)
 {
     std::vector<cv::Mat> frames = gym_frames();
