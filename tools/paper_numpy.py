@@ -171,19 +171,7 @@ def analyse(t, x, y, c, min_conf=pb.MIN_MEAN_CONF, g=pb.G_M_S2):
         j["a_px_s2"] = float(a)
         if abs(c2) > 0.0:
             j["t_apex_s"] = float(t0 - c1 / (2.0 * c2))
-        if not a > 0.0:
-            j["reason"] = "implausible_acceleration"
-            continue
-        q = g / a
-        j["q_m_per_px"] = float(q)
-        j["height_m"] = size_px * q if math.isfinite(size_px) else None
-        tf = j["flight_time_s"]
-        j["jump_height_m"] = g * tf * tf / 8.0
-        j["takeoff_velocity_m_s"] = g * tf / 2.0
-        if j["height_m"] is None:
-            j["reason"] = "no_size"
-        else:
-            j["accepted"] = True
+        pb.scale_jump(j, float(a), g, size_px)
     return jumps, size_px
 
 
