@@ -14,7 +14,8 @@ SUDO=""
 # python3-opencv, python3-venv and opencv-doc for the pose models' converter and its test;
 # Eigen for the ball detector's ballistic fits (and the tests' batch references);
 # clang with its sanitizer/libFuzzer runtime and llvm-symbolizer for tests/fuzz/run.sh;
-# the arm-none-eabi cross compiler with newlib nano and QEMU for the Cortex-M4 firmware check
+# the arm-none-eabi cross compiler with newlib nano and QEMU for the Cortex-M4 firmware check;
+# valgrind (callgrind) for bench_core's instruction counts, python3-numpy for tools/bench_paper.py;
 # the kiosk (docs/kiosk.md): civetweb for its page, SQLite for the history, nlohmann-json;
 # libmosquitto for the MQTT sink and the mosquitto broker (and its clients) its tests start;
 # chromium and chromedriver for the kiosk's browser test (about 13 s to install here)
@@ -22,6 +23,7 @@ pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-de
       python3-opencv python3-venv opencv-doc libeigen3-dev
       clang libclang-rt-14-dev llvm-14
       gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
+      valgrind python3-numpy
       libcivetweb-dev libsqlite3-dev nlohmann-json3-dev libmosquitto-dev mosquitto mosquitto-clients
       openssl chromium chromium-driver)
 missing=()
@@ -37,6 +39,7 @@ fi
 bash tools/setup_cam.sh      # GStreamer base plugins (videotestsrc) and libcamera-dev for gravscale cam
 bash tools/fetch_unity.sh
 bash tools/fetch_models.sh   # BlazePose: npm package -> ONNX in models/ (checksummed)
+bash tools/fetch_engine.sh   # OpenVINO for the pose networks: PyPI wheel into .venv-engine/ (else OpenCV DNN)
 
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build "$BUILD_DIR" -j "$(nproc)"

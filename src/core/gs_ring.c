@@ -1,5 +1,8 @@
 /* gs_ring.c - fixed-capacity ring of packed 16-byte samples in caller storage,
  * addressed by absolute sample index (head keeps counting past the capacity). */
+#ifdef __OPTIMIZE_SIZE__
+#define GS_RING_DEFINE  /* the accessors' one out-of-line copy (gs_ring.h) */
+#endif
 #include "gravscale/gs_ring.h"
 
 #include <math.h>
@@ -69,11 +72,6 @@ static uint8_t w_pack(float w)
     return (uint8_t)(q == 0u ? 1u : q);  /* a usable frame stays usable */
 }
 
-float gs_sample_w(const gs_sample *s)
-{
-    return (float)s->w_q / 255.0f;
-}
-
 static uint8_t upright_pack(float u)
 {
     if (isnan(u)) {
@@ -130,44 +128,6 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     r->last_up_y = s->up_y;
     r->head++;
     return GS_OK;
-}
-
-uint64_t gs_ring_oldest(const gs_ring *r)
-{
-    if (!r) {
-        return 0;
-    }
-    uint64_t o = r->head > r->capacity ? r->head - r->capacity : 0;
-    return r->valid_from > o ? r->valid_from : o;
-}
-
-uint64_t gs_ring_head(const gs_ring *r)
-{
-    return r ? r->head : 0;
-}
-
-uint32_t gs_ring_count(const gs_ring *r)
-{
-    if (!r) {
-        return 0;
-    }
-    return (uint32_t)(r->head - gs_ring_oldest(r));
-}
-
-const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i)
-{
-    if (!r || !r->buf || i >= r->head || i < gs_ring_oldest(r)) {
-        return NULL;
-    }
-    return &r->buf[(uint32_t)(i & r->mask)];
-}
-
-int64_t gs_ring_sample_t_us(const gs_ring *r, const gs_sample *s)
-{
-    /* held samples are less than 2^31 us older than the newest: the modular
-     * difference is their exact age, across any wrap of the 32-bit field */
-    uint32_t age = (uint32_t)(uint64_t)r->t_last_us - s->t_us;
-    return r->t_last_us - (int64_t)age;  /* the time that was pushed: no overflow */
 }
 
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)

@@ -1,26 +1,14 @@
 /* gs_time.c - microsecond times (gs_time.h): spans to seconds and back. */
+#ifdef __OPTIMIZE_SIZE__
+#define GS_TIME_DEFINE  /* gs_time_span_us's one out-of-line copy (gs_time.h) */
+#endif
 #include "gravscale/gs_time.h"
 
 #include <math.h>
 #include <string.h>
 
-#define SPAN_MAX_US INT32_MAX  /* spans saturate here where gs_real is float */
-
 /* one copy (called per sample by the fits and the flight): inlined, it grows every caller */
 #define NOINLINE __attribute__((noinline))
-
-NOINLINE gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us)
-{
-    if (t1_us == GS_T_NONE || t0_us == GS_T_NONE) return (gs_real)NAN;
-    int64_t d = t1_us - t0_us;  /* both within +-2^62: no overflow */
-    if (GS_REAL_IS_FLOAT) {
-        /* int32 -> float is one instruction; int64 -> float a libgcc call */
-        if (d > SPAN_MAX_US) d = SPAN_MAX_US;
-        if (d < -SPAN_MAX_US) d = -SPAN_MAX_US;
-        return (gs_real)(int32_t)d;
-    }
-    return (gs_real)d;
-}
 
 NOINLINE gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us)
 {

@@ -403,9 +403,11 @@ static const double pow10_tab[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1
                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
-static bool parse_number(const char *s, size_t n, double *out)
+/* [sign] digits [. digits] from p (before e), at most 15 digits: the value to *out,
+ * where it stopped to *end; false when no such number starts at p (".5", "-",
+ * "abc", "5."). */
+static bool fast_decimal(const char *p, const char *e, const char **end, double *out)
 {
-    const char *p = s, *e = s + n;
     bool neg = false;
     if (p < e && (*p == '-' || *p == '+')) {
         neg = *p == '-';
@@ -420,7 +422,7 @@ static bool parse_number(const char *s, size_t n, double *out)
         p++;
     }
     if (p == d0)
-        return gs_num_parse(s, n, out); /* ".5", "-", "abc": the full parser decides */
+        return false;
     if (p < e && *p == '.') {
         p++;
         const char *f0 = p;
@@ -431,13 +433,20 @@ static bool parse_number(const char *s, size_t n, double *out)
         }
         frac = (int)(p - f0);
         if (frac == 0)
-            return gs_num_parse(s, n, out);
+            return false;
     }
-    if (p != e)
-        return gs_num_parse(s, n, out); /* exponent, long mantissa or junk: the full parser decides */
     double v = (double)m / pow10_tab[frac];
     *out = neg ? -v : v;
+    *end = p;
     return true;
+}
+
+static bool parse_number(const char *s, size_t n, double *out)
+{
+    const char *end;
+    if (fast_decimal(s, s + n, &end, out) && end == s + n)
+        return true;
+    return gs_num_parse(s, n, out); /* exponent, long mantissa or junk: the full parser decides */
 }
 
 static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl, gs_kpframe *f,
@@ -445,15 +454,23 @@ static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl,
 {
     const char *fs[CSV_MAX_COLS];
     size_t fl[CSV_MAX_COLS];
+    double val[CSV_MAX_COLS];
+    bool quick[CSV_MAX_COLS]; /* the field is a plain decimal, parsed while splitting into val */
     int col = 0;
     const char *p = s, *e = s + n;
     for (;;) {
         const char *q = p;
-        while (q < e && *q != ',')
-            q++;
+        bool fast = col < CSV_MAX_COLS && col < r->ncols && r->role[col] != ROLE_FRAME &&
+                    fast_decimal(p, e, &q, &val[col]) && (q == e || *q == ',');
+        if (!fast) {
+            q = p;
+            while (q < e && *q != ',')
+                q++;
+        }
         if (col < CSV_MAX_COLS) {
             fs[col] = p;
             fl[col] = (size_t)(q - p);
+            quick[col] = fast;
         }
         col++;
         if (q == e)
@@ -475,15 +492,19 @@ static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl,
     uint32_t empty_mask[(CSV_MAX_COLS + 31) / 32] = {0};
     double t = NAN;
     double frame = NAN;
+    bool checks = false; /* an empty field or a confidence outside 0..1: the second pass below */
     f->size_px = NAN;
     for (int c = 0; c < col; c++) {
         const char *v = fs[c];
         size_t vl = fl[c];
-        if (vl > 0 && (v[0] == ' ' || v[0] == '\t' || v[vl - 1] == ' ' || v[vl - 1] == '\t'))
-            trim(&v, &vl);
         double d = NAN;
-        if (vl == 0) {
+        if (!quick[c] && vl > 0 && (v[0] == ' ' || v[0] == '\t' || v[vl - 1] == ' ' || v[vl - 1] == '\t'))
+            trim(&v, &vl);
+        if (quick[c]) {
+            d = val[c]; /* finite, below 1e15: the checks below cannot fail */
+        } else if (vl == 0) {
             empty_mask[c >> 5] |= 1u << (c & 31);
+            checks = true;
         } else if (r->role[c] == ROLE_FRAME) {
             long iv;
             if (!gs_num_parse_int(v, vl, &iv) || iv < 0) {
@@ -507,12 +528,15 @@ static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl,
         case ROLE_FRAME: frame = d; break;
         case ROLE_X: f->kp[r->kidx[c]].x_px = (float)d; break;
         case ROLE_Y: f->kp[r->kidx[c]].y_px = (float)d; break;
-        case ROLE_C: f->kp[r->kidx[c]].c = (float)d; break;
+        case ROLE_C:
+            f->kp[r->kidx[c]].c = (float)d;
+            checks |= !((float)d >= 0.0f && (float)d <= 1.0f);
+            break;
         default: f->size_px = (float)d; break;
         }
     }
     /* checks in column order: first the empty fields, then values */
-    for (int c = 0; c < col; c++) {
+    for (int c = 0; checks && c < col; c++) {
         bool empty = (empty_mask[c >> 5] >> (c & 31)) & 1u;
         uint8_t role = r->role[c];
         if (role == ROLE_C) {

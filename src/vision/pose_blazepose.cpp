@@ -179,6 +179,17 @@ gs_status pose_config_set(void *ctx, const char *key, size_t key_len, const char
         }
         return GS_OK;
     }
+    if (key_is(key, key_len, "engine")) {
+        if (!pose_engine_from_name(v, &c->engine)) {
+            put_msg(msg, cap, "expected auto, opencv or openvino");
+            return GS_EINVAL;
+        }
+        if (!pose_engine_built(c->engine)) {
+            put_msg(msg, cap, "this build has no OpenVINO (tools/fetch_engine.sh installs it; configure again)");
+            return GS_EINVAL;
+        }
+        return GS_OK;
+    }
     if (key_is(key, key_len, "threads")) {
         if ((st = num_in(value, value_len, 0.0, 64.0, &d, msg, cap)) != GS_OK) return st;
         if (d != std::floor(d)) {
@@ -232,18 +243,42 @@ std::string pose_models_dir(const PoseConfig &cfg)
     return GS_MODELS_DEFAULT_DIR;
 }
 
+namespace {
+
+std::string detector_path(const PoseConfig &cfg, PoseEngine e)
+{
+    return pose_models_dir(cfg) + (e == PoseEngine::openvino ? "/pose_detection_strict.onnx" : "/pose_detection.onnx");
+}
+
+std::string landmark_path(const PoseConfig &cfg, PoseEngine e)
+{
+    std::string base = pose_models_dir(cfg) + "/pose_landmark_" + pose_model_name(cfg.model);
+    if (e == PoseEngine::openvino) return base + "_noseg_strict.onnx";
+    // the variant without the segmentation output when setup made it: the mask
+    // is not used, and OpenCV would compute it (lite: ~21 instead of ~30 ms)
+    if (file_exists(base + "_noseg.onnx")) return base + "_noseg.onnx";
+    return base + ".onnx";
+}
+
+}  // namespace
+
+PoseEngine pose_engine_in_force(const PoseConfig &cfg)
+{
+    if (cfg.engine != PoseEngine::automatic) return cfg.engine;
+    if (pose_engine_built(PoseEngine::openvino) && file_exists(detector_path(cfg, PoseEngine::openvino)) &&
+        file_exists(landmark_path(cfg, PoseEngine::openvino)))
+        return PoseEngine::openvino;
+    return PoseEngine::opencv;
+}
+
 std::string pose_detector_path(const PoseConfig &cfg)
 {
-    return pose_models_dir(cfg) + "/pose_detection.onnx";
+    return detector_path(cfg, pose_engine_in_force(cfg));
 }
 
 std::string pose_landmark_path(const PoseConfig &cfg)
 {
-    // the variant without the segmentation output when setup made it: the mask
-    // is not used, and OpenCV would compute it (lite: ~21 instead of ~30 ms)
-    std::string base = pose_models_dir(cfg) + "/pose_landmark_" + pose_model_name(cfg.model);
-    if (file_exists(base + "_noseg.onnx")) return base + "_noseg.onnx";
-    return base + ".onnx";
+    return landmark_path(cfg, pose_engine_in_force(cfg));
 }
 
 bool pose_models_present(const PoseConfig &cfg, std::string &err)
@@ -492,9 +527,10 @@ struct PoseTracker::Impl {
     PoseConfig cfg;
     std::string error;
     bool ok = false;
-    cv::dnn::Net det, lm;
-    std::vector<cv::String> det_out;  // regressors, logits
-    std::vector<cv::String> lm_out;   // landmarks, pose flag[, heatmap]
+    PoseEngine engine = PoseEngine::opencv;  // the one in force
+    std::unique_ptr<PoseNet> det, lm;
+    std::vector<std::string> det_out;  // regressors, logits
+    std::vector<std::string> lm_out;   // landmarks, pose flag[, heatmap]
     bool heatmap_nchw = true;         // heatmap layout of the converted model
     int heatmap_side = 0;             // 0 = no heatmap output
     std::vector<PoseAnchor> anchors = pose_detector_anchors();
@@ -549,32 +585,20 @@ struct PoseTracker::Impl {
         return pose_roi_from_alignment(f[0], f[1], f[2], f[3], kRoiScale);
     }
 
-    bool load(cv::dnn::Net &net, const std::string &path)
+    bool load(std::unique_ptr<PoseNet> &net, const std::string &path)
     {
-        try {
-            net = cv::dnn::readNet(path);
-        } catch (const cv::Exception &e) {
-            error = "cannot load pose model " + path + ": " + e.what();
-            return false;
-        }
-        if (net.empty()) {
-            error = "cannot load pose model " + path;
-            return false;
-        }
-        net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-        net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-        return true;
+        net = pose_net_load(engine, path, cfg.threads, error);
+        return net != nullptr;
     }
 
     // Run a zero input once and name the outputs by their shapes.
     bool find_outputs(const std::string &det_path, const std::string &lm_path)
     {
         try {
-            std::vector<cv::String> names = det.getUnconnectedOutLayersNames();
+            std::vector<std::string> names = det->output_names();
             std::vector<cv::Mat> outs;
-            det.setInput(cv::Mat(std::vector<int>{1, 3, kDetSide, kDetSide}, CV_32F, cv::Scalar(0)));
-            det.forward(outs, names);
-            cv::String reg, logit;
+            det->run(cv::Mat(std::vector<int>{1, 3, kDetSide, kDetSide}, CV_32F, cv::Scalar(0)), names, outs);
+            std::string reg, logit;
             for (size_t i = 0; i < outs.size(); i++) {
                 if (outs[i].total() == anchors.size() * kDetCoords) reg = names[i];
                 else if (outs[i].total() == anchors.size()) logit = names[i];
@@ -585,10 +609,9 @@ struct PoseTracker::Impl {
             }
             det_out = {reg, logit};
 
-            names = lm.getUnconnectedOutLayersNames();
-            lm.setInput(cv::Mat(std::vector<int>{1, 3, kLmSide, kLmSide}, CV_32F, cv::Scalar(0)));
-            lm.forward(outs, names);
-            cv::String pts, flag, hm;
+            names = lm->output_names();
+            lm->run(cv::Mat(std::vector<int>{1, 3, kLmSide, kLmSide}, CV_32F, cv::Scalar(0)), names, outs);
+            std::string pts, flag, hm;
             for (size_t i = 0; i < outs.size(); i++) {
                 const cv::Mat &o = outs[i];
                 if (o.total() == static_cast<size_t>(kLmPoints * kLmValues)) pts = names[i];
@@ -632,9 +655,8 @@ struct PoseTracker::Impl {
             cv::resize(bgr, dst, dst.size(), 0, 0, cv::INTER_AREA);
         }
         blob = cv::dnn::blobFromImage(rgb_det, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), true, false, CV_32F);
-        det.setInput(blob);
         std::vector<cv::Mat> outs;
-        det.forward(outs, det_out);
+        det->run(blob, det_out, outs);
         cv::Mat reg = outs[0].isContinuous() ? outs[0] : outs[0].clone();
         cv::Mat lg = outs[1].isContinuous() ? outs[1] : outs[1].clone();
         return pose_decode_detections(reg.ptr<float>(), lg.ptr<float>(), anchors, lb,
@@ -657,9 +679,8 @@ struct PoseTracker::Impl {
     {
         crop_roi(bgr, r);
         blob = cv::dnn::blobFromImage(crop, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F);
-        lm.setInput(blob);
         std::vector<cv::Mat> outs;
-        lm.forward(outs, lm_out);
+        lm->run(blob, lm_out, outs);
         const float *raw = outs[0].ptr<float>();
         float presence = outs[1].ptr<float>()[0];
         out->presence = presence;
@@ -754,6 +775,8 @@ PoseTracker::PoseTracker(const PoseConfig &cfg) : p_(new Impl)
 {
     p_->cfg = cfg;
     if (!pose_models_present(cfg, p_->error)) return;
+    p_->engine = pose_engine_in_force(cfg);
+    // OpenCV's pool serves its DNN and the frame's image work (process-wide)
     if (cfg.threads > 0) cv::setNumThreads(cfg.threads);
     const std::string dp = pose_detector_path(cfg), lp = pose_landmark_path(cfg);
     if (!p_->load(p_->det, dp) || !p_->load(p_->lm, lp)) return;
@@ -765,6 +788,7 @@ PoseTracker::~PoseTracker() = default;
 
 bool PoseTracker::ok() const { return p_->ok; }
 const std::string &PoseTracker::error() const { return p_->error; }
+PoseEngine PoseTracker::engine() const { return p_->engine; }
 
 void PoseTracker::reset()
 {

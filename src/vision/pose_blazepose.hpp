@@ -31,6 +31,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "pose_engine.hpp"
+
 extern "C" {
 #include "gravscale/gs_config.h"
 #include "gravscale/gs_types.h"
@@ -46,7 +48,8 @@ const char *pose_model_name(PoseModel m);
 struct PoseConfig {
     std::string models_dir;
     PoseModel model = PoseModel::lite;
-    int threads = 0;               // OpenCV threads (process-wide); 0 = leave OpenCV's default
+    PoseEngine engine = PoseEngine::automatic;  // OpenVINO when built in and its models are there, else OpenCV DNN
+    int threads = 0;               // the engine's threads (OpenCV's are process-wide); 0 = its default (the CPUs allowed)
     double min_detection = 0.5;    // detector score that makes a person
     double min_tracking = 0.5;     // pose presence below this = tracking lost
     double nms_iou = 0.3;          // detections overlapping more are merged (weighted NMS)
@@ -66,15 +69,20 @@ struct PoseConfig {
 };
 
 // gs_cfg_handler for [pose]; ctx is a PoseConfig*. Keys: models, model,
-// threads, min_detection, min_tracking, heatmap_refine (on|off),
+// engine (auto|opencv|openvino), threads, min_detection, min_tracking, heatmap_refine (on|off),
 // roi_smoothing (on|off).
 gs_status pose_config_set(void *ctx, const char *key, size_t key_len, const char *value,
                           size_t value_len, char *msg, size_t cap);
 
 // The models folder in force for cfg (see PoseConfig) and the two files used:
-// pose_detection.onnx and pose_landmark_<model>_noseg.onnx when present (no
-// segmentation output, faster), else pose_landmark_<model>.onnx.
+// OpenCV: pose_detection.onnx and pose_landmark_<model>_noseg.onnx when present
+// (no segmentation output, faster), else pose_landmark_<model>.onnx; OpenVINO:
+// the same graphs with the spec form of Clip, pose_detection_strict.onnx and
+// pose_landmark_<model>_noseg_strict.onnx (OpenCV 4.6 reads only the other).
 std::string pose_models_dir(const PoseConfig &cfg);
+// The engine that runs cfg's networks: cfg.engine, or for automatic OpenVINO
+// when this build has it and its two files are in the models folder, else OpenCV.
+PoseEngine pose_engine_in_force(const PoseConfig &cfg);
 std::string pose_detector_path(const PoseConfig &cfg);
 std::string pose_landmark_path(const PoseConfig &cfg);
 // true when both files exist; else false and err names the missing file and
@@ -222,6 +230,8 @@ public:
     // while running (that frame gave no pose; the tracker goes on).
     bool ok() const;
     const std::string &error() const;
+    // the inference engine running the networks (pose_engine_in_force)
+    PoseEngine engine() const;
 
     // One 8-bit frame (BGR; grey and BGRA are converted), any size; fills *out.
     // Returns out->present. Other types give no pose.
