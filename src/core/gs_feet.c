@@ -3,9 +3,6 @@
 
 #include <math.h>
 #include <string.h>
-#ifdef GS_FEET_DEBUG
-#include <stdio.h>
-#endif
 
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
@@ -90,8 +87,9 @@ static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_p
     uint32_t n = held(ft), b = 1;
     if (n < 2) return false;
     while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
-    float du = u_now - f->u_px[slot(ft, b)];
-    return GS_FABS(du) < STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;  /* false for NaN */
+    float du = u_now - f->u_px[slot(ft, b)], lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
+    if (NOISE_K * f->noise_px > lim) lim = NOISE_K * f->noise_px;  /* (jitter is no motion) */
+    return GS_FABS(du) < lim;  /* false for NaN */
 }
 
 /* speed over the interval ending `back` frames before the newest, px/s (NaN unknown) */
@@ -199,9 +197,6 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     uint32_t need_us = f->rest_px > f->floor_px + d + GS_FEET_SINK_REL * size_px ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
     bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
     f->armed = (rested && m <= f->rest_px + d) || (f->armed && (u <= f->rest_px + d + margin || f->lift_pending));
-#ifdef GS_FEET_DEBUG
-    if (f->armed && f->floor_px != f->rest_px) fprintf(stderr, "floor %s t=%lld %.1f -> %.1f (u %.1f m %.1f)\n", f == &ft->pt[0] ? "L" : "R", (long long)t_us, f->floor_px, f->rest_px, u, m);
-#endif
     if (f->armed) f->floor_px = f->rest_px;
     if (m < f->floor_px - d - GS_FEET_SINK_REL * size_px) f->sank_us = t_us;  /* (an ankle may rest delta up, on its toes) */
     /* on the floor: still there, or (toes) not yet risen clear of it since; the run of such frames */

@@ -900,7 +900,6 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         }
         DBG("feet: com %lld..%lld apex %lld -> F0 %lld F1 %lld floors %.1f %.1f before %.1f\n", (long long)c0,
             (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, floor_off, floor_on, floor_before);
-        DBG("   touches L %lld %lld R %lld %lld unsure %d %d falling %d %d\n", (long long)f->feet.pt[0].touch[0].t_us, (long long)f->feet.pt[0].touch[1].t_us, (long long)f->feet.pt[1].touch[0].t_us, (long long)f->feet.pt[1].touch[1].t_us, f->feet.pt[0].touch_unsure, f->feet.pt[1].touch_unsure, f->feet.pt[0].falling, f->feet.pt[1].falling);
         if (F0 != GS_T_NONE && F1 != GS_T_NONE && F1 <= F0) F0 = F1 = GS_T_NONE;
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
