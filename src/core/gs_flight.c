@@ -261,7 +261,7 @@ void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch)
 void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
                     const float y_px[GS_FEET_POINTS], float size_px)
 {
-    if (!f || !f->feet_on) return;
+    if (!GS_WITH_POSE || !f || !f->feet_on) return;
     /* the standing size scales the thresholds; before one is known, the frame's own */
     gs_real size = f->stand_n > 0 ? (gs_real)last_stand_size(f) : (gs_real)size_px;
     gs_feet_push(&f->feet, t_us, x_px, y_px, f->up_x, f->up_y, size);
@@ -888,7 +888,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     int64_t F0 = GS_T_NONE, F1 = GS_T_NONE;
     bool feet_contradict = false;  /* the feet, in view, show no flight there */
     bool fell = false;             /* ... or a fall to a lower floor */
-    if (f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
+    if (GS_WITH_POSE && f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(&r);
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
@@ -1135,7 +1135,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     if (!(s->upright >= STAND_UPRIGHT)) return;
     if (s->t_us - f->still_since_us < STAND_SETTLE_US) return;  /* settled, not rising onto the toes */
     /* sizes are kept for one place: where the feet stand on another floor row, afresh */
-    float floor = f->feet_on ? gs_feet_floor_px(&f->feet) : NAN;
+    float floor = GS_WITH_POSE && f->feet_on ? gs_feet_floor_px(&f->feet) : NAN;
     if (floor == floor) {
         bool same = f->stand_floor_epoch == f->feet.epoch && f->stand_floor_px == f->stand_floor_px;
         if (!same || GS_FABSR((gs_real)(floor - f->stand_floor_px)) > DEPTH_TOL_REL * (gs_real)s->size_px) {
@@ -1277,7 +1277,7 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_ful
     /* the COM may turn before the feet meet the floor (its model is not the body): while a
      * foot that left is still in the air, wait for it a little (the event still leaves well
      * within the landing latency) */
-    if (f->feet_on && f->feet_wait_us == GS_T_NONE && gs_feet_airborne(&f->feet)) {
+    if (GS_WITH_POSE && f->feet_on && f->feet_wait_us == GS_T_NONE && gs_feet_airborne(&f->feet)) {
         f->feet_wait_us = s->t_us + FEET_WAIT_US;
         f->wait_alarm = alarm;
         return;
@@ -1382,7 +1382,7 @@ void gs_flight_update(gs_flight *f)
 /* the stream ends or pauses: close an open candidate (one waiting for its feet with its alarm) */
 static void end_flight(gs_flight *f)
 {
-    if (f->feet_on) gs_feet_flush(&f->feet);
+    if (GS_WITH_POSE && f->feet_on) gs_feet_flush(&f->feet);
     if (f->state != GS_FS_AIRBORNE) return;
     bool waited = f->feet_wait_us != GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
