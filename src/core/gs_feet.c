@@ -69,13 +69,19 @@ static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(
  * interpolated between the two frames around it; GS_T_NONE when none. */
 static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up)
 {
-    for (uint32_t b = 0; b + 1 < held(ft); b++) {
-        float u0 = f->u_px[slot(ft, b + 1)], u1 = f->u_px[slot(ft, b)];
-        bool hit = up ? (u0 <= L && u1 > L) : (u0 > L && u1 <= L);  /* false for NaN */
-        if (!hit) continue;
-        uint32_t a0 = age_us(ft, b + 1), a1 = age_us(ft, b);
-        float w = (L - u0) / (u1 - u0);
-        return ft->t_last_us - (int64_t)a0 + (int32_t)(w * (float)(a0 - a1) + 0.5f);
+    uint32_t newer = UINT32_MAX;  /* the newer frame of the pair: a missing or outlier frame is bridged */
+    for (uint32_t b = 0; b < held(ft); b++) {
+        float u0 = f->u_px[slot(ft, b)];
+        if (!fin(u0)) continue;
+        if (newer != UINT32_MAX) {
+            float u1 = f->u_px[slot(ft, newer)];
+            if (up ? (u0 <= L && u1 > L) : (u0 > L && u1 <= L)) {
+                uint32_t a0 = age_us(ft, b), a1 = age_us(ft, newer);
+                float w = (L - u0) / (u1 - u0);
+                return ft->t_last_us - (int64_t)a0 + (int32_t)(w * (float)(a0 - a1) + 0.5f);
+            }
+        }
+        newer = b;
     }
     return GS_T_NONE;
 }
@@ -152,7 +158,10 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);
     /* the floor slows the point at once (a heel comes down at well under a stature per second); in the air it falls on */
     f->falling = v2 < -FALL_REL * size_px;
-    if (v1 < -FAST_REL * size_px && v2 > v1 / STOP_RATIO && (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
+    float vf = speed(ft, f, 2);  /* (the impact may fall inside the last falling interval) */
+    if (!(vf < v1)) vf = v1;
+    if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
+        (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
         int64_t tc = crossing_us(ft, f, u + d, false);
         if (tc != GS_T_NONE) {
             log_event(f->touch, tc, u, f->floor_px);
