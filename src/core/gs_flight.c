@@ -913,7 +913,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
         /* (toes stop where they land: after it a squat's or a moving camera's frames are no
          * floor; an ankle's recrossing is above the floor it then comes down to) */
         float low_px = F1 != GS_T_NONE && f->feet.stop_touch ? floor_on : gs_feet_low_px(&f->feet);
-        fell = F0 != GS_T_NONE ? low_px < floor_off - d_px - GS_FEET_SINK_REL * (float)gate_size(f, L)
+        fell = F0 != GS_T_NONE ? low_px < floor_off - d_px - FALL_FLOOR_REL * (float)gate_size(f, L)
                                : gs_feet_sank_since(&f->feet, c0);
     }
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
