@@ -105,3 +105,23 @@ __attribute__((section(".isr_vector"), used)) static void (*const k_vectors[16])
     0, 0, 0, 0,
     Default_Handler, Default_Handler, 0, Default_Handler, Default_Handler,
 };
+
+/* ---- memcpy, memset: byte loops ------------------------------------------------- */
+/* newlib nano's word-at-a-time copies cost 470 B of flash; the core copies small structs
+ * and line buffers, where a byte loop is fast enough. Kept out of the loop-to-call pattern
+ * (it would call itself) and marked used: LTO emits calls to them late. */
+#define FW_MEM_FN __attribute__((used, noinline, optimize("no-tree-loop-distribute-patterns")))
+FW_MEM_FN void *memcpy(void *restrict dst, const void *restrict src, size_t n)
+{
+    unsigned char *d = dst;
+    const unsigned char *s = src;
+    while (n--) *d++ = *s++;
+    return dst;
+}
+
+FW_MEM_FN void *memset(void *dst, int c, size_t n)
+{
+    unsigned char *d = dst;
+    while (n--) *d++ = (unsigned char)c;
+    return dst;
+}
