@@ -30,9 +30,14 @@ static void fz_pipe_event(void *ctx, const gs_event *ev)
     else fz_check_nmea_line(buf, n);
     if (ev->type == GS_EV_SUMMARY) fp->summaries++;
     if (ev->type == GS_EV_JUMP && ev->u.jump.accepted) {
-        /* an accepted flight has a finite, positive answer */
-        FZ_CHECK(isfinite(ev->u.jump.height_m) && ev->u.jump.height_m > 0.0);
+        /* an accepted flight has a finite, positive scale and jump; its height is unknown
+         * (NaN) only when it says why: no standing size, or one at another depth */
+        const uint32_t sizeless = GS_WARN_NO_SIZE | GS_WARN_DEPTH_CHANGED;
+        if (ev->u.jump.warnings & sizeless) FZ_CHECK(isnan(ev->u.jump.height_m));
+        else FZ_CHECK(isfinite(ev->u.jump.height_m) && ev->u.jump.height_m > 0.0);
         FZ_CHECK(isfinite(ev->u.jump.q_m_per_px) && ev->u.jump.q_m_per_px > 0.0);
+        FZ_CHECK(isfinite(ev->u.jump.flight_time_s) && ev->u.jump.flight_time_s > 0.0);
+        FZ_CHECK(isfinite(ev->u.jump.jump_height_m) && ev->u.jump.jump_height_m > 0.0);
     }
 }
 
