@@ -436,6 +436,7 @@ struct ClipResult {
     std::map<int, double> size;             // track -> summary height_m (NaN null)
     std::vector<std::string> reasons;       // per jump: "" accepted, else the reason
     int n_jumps = 0, n_accepted = 0;
+    int n_unknown_as_number = 0;            // jumps with no take-off whose rise, contact or RSI is a number
 };
 
 // the value after "key": in a JSON line (a number, or NaN for null/absent)
@@ -466,6 +467,10 @@ ClipResult run_program(const char *clip)
             r.n_accepted += acc ? 1 : 0;
             size_t p = line.find("\"reason\":\"");
             r.reasons.push_back(acc || p == std::string::npos ? "" : line.substr(p + 10, line.find('"', p + 10) - p - 10));
+            if (!std::isfinite(json_num(line, "takeoff_velocity_m_s")) &&
+                (std::isfinite(json_num(line, "com_rise_m")) || std::isfinite(json_num(line, "contact_time_s")) ||
+                 std::isfinite(json_num(line, "rsi"))))
+                r.n_unknown_as_number++;
         }
     }
     r.rc = pclose(f);
@@ -579,6 +584,8 @@ void test_real_juggling_sizes_agree(void)
     }
     TEST_ASSERT_EQUAL(0, r.rc);
     TEST_ASSERT_TRUE_MESSAGE(hi > 0, "a juggling ball measured");
+    // a ball caught and thrown has no take-off from the floor: its rise, contact and RSI are unknown
+    TEST_ASSERT_EQUAL_MESSAGE(0, r.n_unknown_as_number, "a jump without a take-off velocity gives no rise, contact or RSI");
     TEST_ASSERT_TRUE(hi / lo - 1.0 <= 0.10);
 }
 

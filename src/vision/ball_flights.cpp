@@ -374,6 +374,7 @@ bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
     j->q_m_per_px = opt_.g_m_s2 / amag;
     j->jump_height_m = NAN;  // no take-off from the ground: a ball released or entering
     j->takeoff_velocity_m_s = NAN;
+    j->com_rise_m = j->contact_time_s = j->rsi = NAN;
     j->n_samples = (uint32_t)pts.size();
     j->n_outliers = (uint32_t)(a0.pts.size() - pts.size());
     j->rms_px = fit.rms_px;
