@@ -86,14 +86,28 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
     return GS_T_NONE;
 }
 
-/* still: the height u_now moved less than STILL_REL x size per second against the frame
- * about LAG_US back (the oldest held when the history is shorter) */
+/* the median of the point's heights `back`, `back`+1 and `back`+2 frames before the newest
+ * (a lone outlier does not move it); the height `back` alone when those are not all known */
+static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
+{
+    float a = f->u_px[slot(ft, back)];
+    if (back + 3u > held(ft)) return a;
+    float b = f->u_px[slot(ft, back + 1u)], c = f->u_px[slot(ft, back + 2u)];
+    if (!fin(a) || !fin(b) || !fin(c)) return a;
+    if (a > b) { float t = a; a = b; b = t; }
+    if (b > c) b = c;
+    return a > b ? a : b;
+}
+
+/* still: the (median) height u_now moved less than STILL_REL x size per second against the
+ * median about LAG_US back (the oldest held when the history is shorter): a detector's lone
+ * jittery frame, there or here, is no motion */
 static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_px)
 {
     uint32_t n = held(ft), b = 1;
     if (n < 2) return false;
     while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
-    float du = u_now - f->u_px[slot(ft, b)], lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
+    float du = u_now - med3_at(ft, f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
     if (NOISE_K * f->noise_px > lim) lim = NOISE_K * f->noise_px;  /* (jitter is no motion) */
     return GS_FABS(du) < lim;  /* false for NaN */
 }
@@ -106,18 +120,6 @@ static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
     return (f->u_px[slot(ft, back)] - f->u_px[slot(ft, back + 1)]) / ((float)dt * 1e-6f);
 }
 
-/* the median of the point's last three heights (a lone outlier does not move it); the newest
- * alone when fewer are known */
-static float med3_now(const gs_feet *ft, const gs_foot *f)
-{
-    float a = f->u_px[slot(ft, 0)];
-    if (held(ft) < 3) return a;
-    float b = f->u_px[slot(ft, 1)], c = f->u_px[slot(ft, 2)];
-    if (!fin(b) || !fin(c)) return a;
-    if (a > b) { float t = a; a = b; b = t; }
-    if (b > c) b = c;
-    return a > b ? a : b;
-}
 
 static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float size_px)
 {
@@ -182,7 +184,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* the floor level: what the point rests on at its lowest (median heights: an outlier is
      * no step). A rest below it is a new floor, one far above it too (stepping up); a slow
      * rise in between (a heel or a toe rolling up before take-off) is leaving it */
-    float m = med3_now(ft, f);
+    float m = med3_at(ft, f, 0);
     bool st = still(ft, f, m, size_px);
     if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
         float d2 = GS_FABS(u - 2.0f * f->u_px[slot(ft, 1)] + f->u_px[slot(ft, 2)]) / 1.954f;
