@@ -19,4 +19,13 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-halt_on_error=1:abort_on_error=0:detect_leak
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$top/tools/sanitizer/lsan.supp:print_suppressions=0}
 # generous per-test limit: instrumented code runs 2-4x slower
-ctest --test-dir "$SAN_BUILD_DIR" --output-on-failure -j "$(nproc)" --timeout 1800 "$@"
+# The sanitized build runs the pose networks in OpenCV's DNN (OpenVINO's CPU plugin
+# cannot load under the sanitizer runtime: CMakeLists.txt). Two tests of the handheld gym
+# clip assert what the OpenVINO keypoints give and run in the plain suite only: with a
+# walker hiding the feet at the apex (test_pose_crossing) the flight is timed from the COM,
+# and OpenCV's keypoints put that 0.667 s instead of 0.826 s; the kiosk (cam path, no
+# stabilisation) sees the tilting camera's floor drop by 0.1 stature with OpenCV's toes and
+# rejects the jump as a fall (py_test_kiosk_browser). test_pose_video times the same clip
+# with both engines.
+ctest --test-dir "$SAN_BUILD_DIR" --output-on-failure -j "$(nproc)" --timeout 1800 \
+  -E '^(test_pose_crossing|py_test_kiosk_browser)$' "$@"
