@@ -36,6 +36,12 @@ struct CameraMotionFrame {
     int other = 0;                 // corners around the subjects moving against the background
 };
 
+// cv::resize(src, dst, Size(), f, f, INTER_AREA) for 8-bit grey and 0 < f <= 1,
+// with the same pixels (OpenCV's area weights, summed in its order in float),
+// without OpenCV's per-weight read-modify-write of one accumulator, which makes
+// a non-integer reduction (720 -> 640 px) cost several times a whole-factor one.
+void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f);
+
 class CameraMotion {
 public:
     explicit CameraMotion(const CameraMotionConfig &cfg = CameraMotionConfig());
