@@ -133,7 +133,8 @@ void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
             if (e < n) xa[static_cast<size_t>(dx) * k + e] = xt.alpha[a + e];
         }
     }
-    cv::Mat out(ds, CV_8UC1);
+    cv::Mat out = dst.data == src.data ? cv::Mat() : dst;  // dst's own memory unless it is src's
+    out.create(ds, CV_8UC1);
     const int w = ds.width;
     std::vector<float> row(src.cols), buf(w), sum(w);
     int buf_row = -1;
@@ -208,15 +209,17 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
     }
     frames_++;
     scale_ = std::min(1.0, cfg_.work_width_px / bgr.cols);
-    cv::Mat grey, cur;
-    if (bgr.channels() == 3)
-        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    else
-        grey = bgr;
+    // the working images and pyramids reuse their memory from frame to frame
+    const cv::Mat *grey = &bgr;
+    if (bgr.channels() == 3) {
+        cv::cvtColor(bgr, grey_, cv::COLOR_BGR2GRAY);
+        grey = &grey_;
+    }
+    cv::Mat &cur = cur_;
     if (scale_ < 1.0)
-        resize_area_grey(grey, cur, scale_);
+        resize_area_grey(*grey, cur, scale_);
     else
-        cur = grey.clone();
+        grey->copyTo(cur);
 
     // subjects' regions at the working scale, grown by a margin (limbs swing out of boxes)
     std::vector<cv::Rect> ex;
@@ -231,7 +234,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
     // with its gradients, which both Lucas-Kanade passes would otherwise compute again
     const cv::Size win(21, 21);
     const int levels = 3;
-    std::vector<cv::Mat> pyr;
+    std::vector<cv::Mat> &pyr = spare_pyr_;
     cv::buildOpticalFlowPyramid(cur, pyr, win, levels, true);
 
     bool matched = false;
@@ -280,7 +283,9 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
 
     // refill the corners when they thin out (occlusion, leaving the view)
     if ((int)pts_.size() < cfg_.max_features / 2) {
-        cv::Mat mask(cur.size(), CV_8U, cv::Scalar(255));
+        cv::Mat &mask = mask_;
+        mask.create(cur.size(), CV_8U);
+        mask.setTo(255);
         for (const cv::Rect &r : ex) mask(r & cv::Rect(0, 0, cur.cols, cur.rows)).setTo(0);
         for (const cv::Point2f &p : pts_)
             cv::circle(mask, p, (int)cfg_.min_spacing_px, cv::Scalar(0), -1);
@@ -315,7 +320,9 @@ int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vecto
     if (ex.empty() || cfg_.ring_features <= 0 || prev_pyr_.empty()) return 0;
     const cv::Mat &prev = prev_pyr_[0];  // level 0: the previous working grey frame
     cv::Rect all(0, 0, prev.cols, prev.rows);
-    cv::Mat mask(prev.size(), CV_8U, cv::Scalar(0));
+    cv::Mat &mask = ring_mask_;
+    mask.create(prev.size(), CV_8U);
+    mask.setTo(0);
     for (const cv::Rect &r : ex) {
         int g = (int)std::lround(cfg_.ring_rel * std::max(r.width, r.height));
         mask(cv::Rect(r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g) & all).setTo(255);

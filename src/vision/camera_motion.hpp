@@ -55,6 +55,9 @@ private:
     CameraMotionConfig cfg_;
     double scale_ = 1.0;           // working / full
     std::vector<cv::Mat> prev_pyr_; // previous working grey frame's Lucas-Kanade pyramid
+    std::vector<cv::Mat> spare_pyr_; // the one before, whose memory the next pyramid takes
+    cv::Mat grey_, cur_, mask_;     // this frame's grey, working image and corner mask
+    mutable cv::Mat ring_mask_;     // other_motion's ring
     std::vector<cv::Point2f> pts_; // corners in prev_
     cv::Matx23d cur_from_ref_;     // full-frame pixels: reference -> current
     bool have_ = false;
