@@ -302,6 +302,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
                 int want = per_cell - have[gy * grid + gx];
                 if (want <= 0) continue;
                 cv::Rect cell(gx * cur.cols / grid, gy * cur.rows / grid, cur.cols / grid, cur.rows / grid);
+                if (cv::countNonZero(mask(cell)) == 0) continue;  // all covered: no corner can come of it
                 std::vector<cv::Point2f> fresh;
                 cv::goodFeaturesToTrack(cur(cell), fresh, want, 0.01, cfg_.min_spacing_px, mask(cell), 5);
                 for (cv::Point2f &p : fresh) pts_.push_back(p + cv::Point2f((float)cell.x, (float)cell.y));
