@@ -210,6 +210,48 @@ static void test_real_handheld_camera(void)
     TEST_ASSERT_TRUE_MESSAGE(dyr > 20.0 && dyr < 80.0, "the handheld drift is seen at its size");
 }
 
+// the working image is OpenCV's INTER_AREA reduction pixel for pixel: real
+// frames at the working scales of 720p and 1080p, and random images and scales
+static void test_area_reduction_is_opencvs(void)
+{
+    std::vector<cv::Mat> greys;
+    char p_buf[512];
+    std::snprintf(p_buf, sizeof p_buf, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    if (exists(p_buf)) {
+        cv::VideoCapture cap(p_buf);
+        cv::Mat f, g;
+        for (int i = 0; i < 10 && cap.read(f); i++) {
+            cv::cvtColor(f, g, cv::COLOR_BGR2GRAY);
+            greys.push_back(g.clone());
+            cv::resize(g, g, cv::Size(1080, 1920));
+            greys.push_back(g.clone());
+        }
+    }
+    int cases = 0, same = 0;
+    for (const cv::Mat &g : greys) {
+        cv::Mat a, b;
+        double f = 640.0 / g.cols;
+        cv::resize(g, a, cv::Size(), f, f, cv::INTER_AREA);
+        gs::resize_area_grey(g, b, f);
+        cases++;
+        same += a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+    }
+    cv::RNG rng(7);
+    for (int i = 0; i < 200; i++) {
+        cv::Mat g(rng.uniform(8, 700), rng.uniform(8, 700), CV_8UC1);
+        rng.fill(g, cv::RNG::UNIFORM, 0, 256);
+        double f = rng.uniform(0.05, 1.0);
+        if (i % 10 == 0) f = 1.0 / (1 + i % 3);  // whole factors and none
+        cv::Mat a, b;
+        cv::resize(g, a, cv::Size(), f, f, cv::INTER_AREA);
+        gs::resize_area_grey(g, b, f);
+        cases++;
+        same += a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+    }
+    std::printf("area reduction: %d of %d images as cv::resize\n", same, cases);
+    TEST_ASSERT_EQUAL_INT(cases, same);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -218,5 +260,6 @@ int main(void)
     RUN_TEST(test_other_motion_beside_the_subject);
     RUN_TEST(test_real_static_camera);
     RUN_TEST(test_real_handheld_camera);
+    RUN_TEST(test_area_reduction_is_opencvs);
     return UNITY_END();
 }

@@ -3,7 +3,12 @@
 #include "camera_motion.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -26,6 +31,42 @@ cv::Point2d apply(const cv::Matx23d &m, cv::Point2d p)
     return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
 }
 
+// OpenCV's area table along one axis (resize.cpp, computeResizeAreaTab): for
+// each output index, the source indices and weights in the order it sums them
+struct AreaTab {
+    std::vector<int> first;   // entries of output i: [first[i], first[i + 1])
+    std::vector<int> src;
+    std::vector<float> alpha;
+};
+
+AreaTab area_tab(int ssize, int dsize, double scale)
+{
+    AreaTab t;
+    for (int dx = 0; dx < dsize; dx++) {
+        t.first.push_back(static_cast<int>(t.src.size()));
+        double fsx1 = dx * scale;
+        double fsx2 = fsx1 + scale;
+        double cell = std::min(scale, ssize - fsx1);
+        int sx1 = cvCeil(fsx1), sx2 = cvFloor(fsx2);
+        sx2 = std::min(sx2, ssize - 1);
+        sx1 = std::min(sx1, sx2);
+        if (sx1 - fsx1 > 1e-3) {
+            t.src.push_back(sx1 - 1);
+            t.alpha.push_back(static_cast<float>((sx1 - fsx1) / cell));
+        }
+        for (int sx = sx1; sx < sx2; sx++) {
+            t.src.push_back(sx);
+            t.alpha.push_back(static_cast<float>(1.0 / cell));
+        }
+        if (fsx2 - sx2 > 1e-3) {
+            t.src.push_back(sx2);
+            t.alpha.push_back(static_cast<float>(std::min(std::min(fsx2 - sx2, 1.), cell) / cell));
+        }
+    }
+    t.first.push_back(static_cast<int>(t.src.size()));
+    return t;
+}
+
 bool inside_any(const std::vector<cv::Rect> &rs, cv::Point2f p)
 {
     for (const cv::Rect &r : rs)
@@ -34,6 +75,125 @@ bool inside_any(const std::vector<cv::Rect> &rs, cv::Point2f p)
 }
 
 }  // namespace
+
+namespace {
+
+#if defined(__SSE2__) && !defined(__FMA__)
+constexpr bool kExactAreaSums = true;
+#else
+constexpr bool kExactAreaSums = false;
+#endif
+
+// one source row (as floats) summed across into the w output columns, k weights each
+template <int K>
+inline void sum_across(const float *row, const int *ix, const float *al, int w, float *buf)
+{
+    for (int dx = 0; dx < w; dx++, ix += K, al += K) {
+        float v = 0.0f;
+        for (int e = 0; e < K; e++) v += row[ix[e]] * al[e];
+        buf[dx] = v;
+    }
+}
+
+inline void sum_across_k(const float *row, const int *ix, const float *al, int w, int k, float *buf)
+{
+    for (int dx = 0; dx < w; dx++, ix += k, al += k) {
+        float v = 0.0f;
+        for (int e = 0; e < k; e++) v += row[ix[e]] * al[e];
+        buf[dx] = v;
+    }
+}
+
+}  // namespace
+
+void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
+{
+    CV_Assert(src.type() == CV_8UC1 && f > 0.0 && f <= 1.0);
+    // cv::resize's output size and its scale (from f, not from the sizes)
+    cv::Size ds(cv::saturate_cast<int>(src.cols * f), cv::saturate_cast<int>(src.rows * f));
+    const double scale = 1.0 / f;
+    const int iscale = cv::saturate_cast<int>(scale);
+    // OpenCV's own path: a copy, a whole factor, or a CPU whose compiler may fuse a
+    // multiply and an add (FMA), which rounds once where OpenCV's sums round twice
+    if (!kExactAreaSums || ds == src.size() || std::abs(scale - iscale) < DBL_EPSILON || ds.width <= 0 ||
+        ds.height <= 0) {
+        cv::resize(src, dst, cv::Size(), f, f, cv::INTER_AREA);
+        return;
+    }
+    const AreaTab xt = area_tab(src.cols, ds.width, scale), yt = area_tab(src.rows, ds.height, scale);
+    // the entries of one output column padded to k with weight 0: adding S x 0 = +0 leaves a sum >= 0 as it is
+    int k = 0;
+    for (int dx = 0; dx < ds.width; dx++) k = std::max(k, xt.first[dx + 1] - xt.first[dx]);
+    std::vector<int> xi(static_cast<size_t>(k) * ds.width);
+    std::vector<float> xa(xi.size(), 0.0f);
+    for (int dx = 0; dx < ds.width; dx++) {
+        const int a = xt.first[dx], n = xt.first[dx + 1] - a;
+        for (int e = 0; e < k; e++) {
+            xi[static_cast<size_t>(dx) * k + e] = xt.src[a + std::min(e, n - 1)];
+            if (e < n) xa[static_cast<size_t>(dx) * k + e] = xt.alpha[a + e];
+        }
+    }
+    cv::Mat out = dst.data == src.data ? cv::Mat() : dst;  // dst's own memory unless it is src's
+    out.create(ds, CV_8UC1);
+    const int w = ds.width;
+    std::vector<float> row(src.cols), buf(w), sum(w);
+    int buf_row = -1;
+    for (int dy = 0; dy < ds.height; dy++) {
+        for (int j = yt.first[dy]; j < yt.first[dy + 1]; j++) {
+            const int sy = yt.src[j];
+            if (sy != buf_row) {  // a source row shared by two output rows is summed across once
+                const uchar *S = src.ptr<uchar>(sy);
+                int x = 0;
+#ifdef __SSE2__
+                const __m128i z = _mm_setzero_si128();
+                for (; x + 16 <= src.cols; x += 16) {
+                    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i *>(S + x));
+                    __m128i lo = _mm_unpacklo_epi8(v, z), hi = _mm_unpackhi_epi8(v, z);
+                    _mm_storeu_ps(&row[x], _mm_cvtepi32_ps(_mm_unpacklo_epi16(lo, z)));
+                    _mm_storeu_ps(&row[x + 4], _mm_cvtepi32_ps(_mm_unpackhi_epi16(lo, z)));
+                    _mm_storeu_ps(&row[x + 8], _mm_cvtepi32_ps(_mm_unpacklo_epi16(hi, z)));
+                    _mm_storeu_ps(&row[x + 12], _mm_cvtepi32_ps(_mm_unpackhi_epi16(hi, z)));
+                }
+#endif
+                for (; x < src.cols; x++) row[x] = S[x];
+                if (k == 3)
+                    sum_across<3>(row.data(), xi.data(), xa.data(), w, buf.data());
+                else if (k == 2)
+                    sum_across<2>(row.data(), xi.data(), xa.data(), w, buf.data());
+                else
+                    sum_across_k(row.data(), xi.data(), xa.data(), w, k, buf.data());
+                buf_row = sy;
+            }
+            const float beta = yt.alpha[j];
+            int dx = 0;
+            if (j == yt.first[dy]) {
+#ifdef __SSE2__
+                const __m128 b4 = _mm_set1_ps(beta);
+                for (; dx + 4 <= w; dx += 4) _mm_storeu_ps(&sum[dx], _mm_mul_ps(b4, _mm_loadu_ps(&buf[dx])));
+#endif
+                for (; dx < w; dx++) sum[dx] = beta * buf[dx];
+            } else {
+#ifdef __SSE2__
+                const __m128 b4 = _mm_set1_ps(beta);
+                for (; dx + 4 <= w; dx += 4)
+                    _mm_storeu_ps(&sum[dx], _mm_add_ps(_mm_loadu_ps(&sum[dx]), _mm_mul_ps(b4, _mm_loadu_ps(&buf[dx]))));
+#endif
+                for (; dx < w; dx++) sum[dx] += beta * buf[dx];
+            }
+        }
+        uchar *D = out.ptr<uchar>(dy);
+        int dx = 0;
+#ifdef __SSE2__
+        // cvRound's rounding (to nearest, ties to even) and saturation, 8 at a time
+        for (; dx + 8 <= w; dx += 8) {
+            __m128i a = _mm_cvtps_epi32(_mm_loadu_ps(&sum[dx])), b = _mm_cvtps_epi32(_mm_loadu_ps(&sum[dx + 4]));
+            _mm_storel_epi64(reinterpret_cast<__m128i *>(D + dx), _mm_packus_epi16(_mm_packs_epi32(a, b), a));
+        }
+#endif
+        for (; dx < w; dx++) D[dx] = cv::saturate_cast<uchar>(sum[dx]);
+    }
+    dst = out;
+}
 
 CameraMotion::CameraMotion(const CameraMotionConfig &cfg) : cfg_(cfg), cur_from_ref_(1, 0, 0, 0, 1, 0) {}
 
@@ -49,15 +209,17 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
     }
     frames_++;
     scale_ = std::min(1.0, cfg_.work_width_px / bgr.cols);
-    cv::Mat grey, cur;
-    if (bgr.channels() == 3)
-        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    else
-        grey = bgr;
+    // the working images and pyramids reuse their memory from frame to frame
+    const cv::Mat *grey = &bgr;
+    if (bgr.channels() == 3) {
+        cv::cvtColor(bgr, grey_, cv::COLOR_BGR2GRAY);
+        grey = &grey_;
+    }
+    cv::Mat &cur = cur_;
     if (scale_ < 1.0)
-        cv::resize(grey, cur, cv::Size(), scale_, scale_, cv::INTER_AREA);
+        resize_area_grey(*grey, cur, scale_);
     else
-        cur = grey.clone();
+        grey->copyTo(cur);
 
     // subjects' regions at the working scale, grown by a margin (limbs swing out of boxes)
     std::vector<cv::Rect> ex;
@@ -68,11 +230,12 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
     }
 
     // the pyramid of this frame, built once: it is the next frame's previous one
-    // (calcOpticalFlowPyrLK given the images builds the same pyramids, both each time)
+    // (calcOpticalFlowPyrLK given the images builds the same pyramids, both each time);
+    // with its gradients, which both Lucas-Kanade passes would otherwise compute again
     const cv::Size win(21, 21);
     const int levels = 3;
-    std::vector<cv::Mat> pyr;
-    cv::buildOpticalFlowPyramid(cur, pyr, win, levels, false);
+    std::vector<cv::Mat> &pyr = spare_pyr_;
+    cv::buildOpticalFlowPyramid(cur, pyr, win, levels, true);
 
     bool matched = false;
     if (have_ && !pts_.empty()) {
@@ -120,7 +283,9 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
 
     // refill the corners when they thin out (occlusion, leaving the view)
     if ((int)pts_.size() < cfg_.max_features / 2) {
-        cv::Mat mask(cur.size(), CV_8U, cv::Scalar(255));
+        cv::Mat &mask = mask_;
+        mask.create(cur.size(), CV_8U);
+        mask.setTo(255);
         for (const cv::Rect &r : ex) mask(r & cv::Rect(0, 0, cur.cols, cur.rows)).setTo(0);
         for (const cv::Point2f &p : pts_)
             cv::circle(mask, p, (int)cfg_.min_spacing_px, cv::Scalar(0), -1);
@@ -137,6 +302,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
                 int want = per_cell - have[gy * grid + gx];
                 if (want <= 0) continue;
                 cv::Rect cell(gx * cur.cols / grid, gy * cur.rows / grid, cur.cols / grid, cur.rows / grid);
+                if (cv::countNonZero(mask(cell)) == 0) continue;  // all covered: no corner can come of it
                 std::vector<cv::Point2f> fresh;
                 cv::goodFeaturesToTrack(cur(cell), fresh, want, 0.01, cfg_.min_spacing_px, mask(cell), 5);
                 for (cv::Point2f &p : fresh) pts_.push_back(p + cv::Point2f((float)cell.x, (float)cell.y));
@@ -155,7 +321,9 @@ int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vecto
     if (ex.empty() || cfg_.ring_features <= 0 || prev_pyr_.empty()) return 0;
     const cv::Mat &prev = prev_pyr_[0];  // level 0: the previous working grey frame
     cv::Rect all(0, 0, prev.cols, prev.rows);
-    cv::Mat mask(prev.size(), CV_8U, cv::Scalar(0));
+    cv::Mat &mask = ring_mask_;
+    mask.create(prev.size(), CV_8U);
+    mask.setTo(0);
     for (const cv::Rect &r : ex) {
         int g = (int)std::lround(cfg_.ring_rel * std::max(r.width, r.height));
         mask(cv::Rect(r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g) & all).setTo(255);

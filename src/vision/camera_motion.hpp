@@ -36,6 +36,12 @@ struct CameraMotionFrame {
     int other = 0;                 // corners around the subjects moving against the background
 };
 
+// cv::resize(src, dst, Size(), f, f, INTER_AREA) for 8-bit grey and 0 < f <= 1,
+// with the same pixels (OpenCV's area weights, summed in its order in float),
+// without OpenCV's per-weight read-modify-write of one accumulator, which makes
+// a non-integer reduction (720 -> 640 px) cost several times a whole-factor one.
+void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f);
+
 class CameraMotion {
 public:
     explicit CameraMotion(const CameraMotionConfig &cfg = CameraMotionConfig());
@@ -49,6 +55,9 @@ private:
     CameraMotionConfig cfg_;
     double scale_ = 1.0;           // working / full
     std::vector<cv::Mat> prev_pyr_; // previous working grey frame's Lucas-Kanade pyramid
+    std::vector<cv::Mat> spare_pyr_; // the one before, whose memory the next pyramid takes
+    cv::Mat grey_, cur_, mask_;     // this frame's grey, working image and corner mask
+    mutable cv::Mat ring_mask_;     // other_motion's ring
     std::vector<cv::Point2f> pts_; // corners in prev_
     cv::Matx23d cur_from_ref_;     // full-frame pixels: reference -> current
     bool have_ = false;

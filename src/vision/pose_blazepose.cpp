@@ -539,7 +539,7 @@ struct PoseTracker::Impl {
     OneEuro roi_filter[4];  // alignment points x0, y0, x1, y1 in ROI sizes
     double last_t_s = 0.0;
     double roi_unit_px = 1.0;
-    cv::Mat rgb_det, det_half, crop, blob;
+    cv::Mat rgb_det, det_half, crop, blob, blob_det;  // kept: each frame writes into the same memory
     double align[4] = {0, 0, 0, 0};  // the last landmarks' alignment points, image px
     cv::Mat converted;                // a grey or BGRA frame as BGR
 
@@ -654,9 +654,9 @@ struct PoseTracker::Impl {
         } else {
             cv::resize(bgr, dst, dst.size(), 0, 0, cv::INTER_AREA);
         }
-        blob = cv::dnn::blobFromImage(rgb_det, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), true, false, CV_32F);
+        cv::dnn::blobFromImage(rgb_det, blob_det, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), true, false, CV_32F);
         std::vector<cv::Mat> outs;
-        det->run(blob, det_out, outs);
+        det->run(blob_det, det_out, outs);
         cv::Mat reg = outs[0].isContinuous() ? outs[0] : outs[0].clone();
         cv::Mat lg = outs[1].isContinuous() ? outs[1] : outs[1].clone();
         return pose_decode_detections(reg.ptr<float>(), lg.ptr<float>(), anchors, lb,
@@ -678,7 +678,7 @@ struct PoseTracker::Impl {
     void landmarks(const cv::Mat &bgr, const PoseRoi &r, PoseOutput *out, PoseRoi *next)
     {
         crop_roi(bgr, r);
-        blob = cv::dnn::blobFromImage(crop, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F);
+        cv::dnn::blobFromImage(crop, blob, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F);
         std::vector<cv::Mat> outs;
         lm->run(blob, lm_out, outs);
         const float *raw = outs[0].ptr<float>();
