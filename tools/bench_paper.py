@@ -11,8 +11,8 @@ the other, `gravscale replay --keypoints FILE` and `paper_numpy.py FILE` as
 processes (stdout to /dev/null), and times the NumPy method in this process too
 (reading the CSV and the method, without the interpreter's start and the
 imports), next to bench_replay's own in-process figure for gravscale on the same
-file (the `gravscale` program also loads the vision libraries at start, ~0.12 s
-here, before a replay begins). Reported: the best and the median of the repeats (wall s, frames/s,
+file (`gravscale` links the core and the I/O only and starts in about 1 ms: the
+vision libraries are in gravscale-vision.so, which only `video` and `cam` load). Reported: the best and the median of the repeats (wall s, frames/s,
 CPU s), the ratios, and both results (jumps found, median height). --pure also
 runs the pure-Python paper_baseline.py once. Load: the 1-min load average
 before and after. Needs numpy (Debian's python3-numpy).

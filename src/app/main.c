@@ -6,11 +6,45 @@
 
 /* Defined in cmd_replay.c (no app header yet: one prototype per side). */
 int gs_cmd_replay(int argc, char **argv);
-#if defined(GS_HAVE_VISION) && GS_HAVE_VISION
-/* Defined in cmd_video.cpp (C++, extern "C"). */
-int gs_cmd_video(int argc, char **argv);
-/* Defined in cmd_cam.cpp (C++, extern "C"). */
-int gs_cmd_cam(int argc, char **argv);
+
+#ifdef GS_VISION_MODULE
+#include <dlfcn.h>
+#include <limits.h>
+#include <unistd.h>
+
+/* video and cam: gs_cmd_video / gs_cmd_cam (cmd_video.cpp, cmd_cam.cpp) in the
+ * module next to this program, loaded only now so that replay never maps OpenCV. */
+static int run_vision(const char *cmd, const char *entry, int argc, char **argv)
+{
+    char path[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+    if (n <= 0) {
+        fprintf(stderr, "gravscale: %s: cannot find this program's directory (/proc/self/exe)\n", cmd);
+        return 2;
+    }
+    path[n] = '\0';
+    char *slash = strrchr(path, '/');
+    size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
+    if (dir + sizeof GS_VISION_MODULE > sizeof path) {
+        fprintf(stderr, "gravscale: %s: program path too long\n", cmd);
+        return 2;
+    }
+    memcpy(path + dir, GS_VISION_MODULE, sizeof GS_VISION_MODULE);
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        fprintf(stderr, "gravscale: %s: the vision commands' library %s could not be loaded (%s); "
+                        "it is built with the program and must sit next to it\n",
+                cmd, path, dlerror());
+        return 2;
+    }
+    int (*fn)(int, char **);
+    *(void **)&fn = dlsym(h, entry); /* POSIX's way from an object pointer to a function */
+    if (!fn) {
+        fprintf(stderr, "gravscale: %s: %s has no %s (%s)\n", cmd, path, entry, dlerror());
+        return 2;
+    }
+    return fn(argc, argv); /* the module stays loaded until exit: its atexit handlers need it */
+}
 #endif
 
 static void usage(FILE *f)
@@ -57,8 +91,8 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "replay") == 0)
         return gs_cmd_replay(argc - 1, argv + 1);
     if (strcmp(cmd, "video") == 0) {
-#if defined(GS_HAVE_VISION) && GS_HAVE_VISION
-        return gs_cmd_video(argc - 1, argv + 1);
+#ifdef GS_VISION_MODULE
+        return run_vision("video", "gs_cmd_video", argc - 1, argv + 1);
 #else
         fputs("gravscale: built without OpenCV: the video command is not available "
               "(install libopencv-dev and libavformat-dev, then rebuild)\n", stderr);
@@ -66,8 +100,8 @@ int main(int argc, char **argv)
 #endif
     }
     if (strcmp(cmd, "cam") == 0) {
-#if defined(GS_HAVE_VISION) && GS_HAVE_VISION
-        return gs_cmd_cam(argc - 1, argv + 1);
+#ifdef GS_VISION_MODULE
+        return run_vision("cam", "gs_cmd_cam", argc - 1, argv + 1);
 #else
         fputs("gravscale: built without OpenCV: the cam command is not available "
               "(install libopencv-dev and libavformat-dev, then rebuild)\n", stderr);

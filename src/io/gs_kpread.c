@@ -13,6 +13,7 @@
 
 #include "gravscale/gs_com.h"
 #include "gravscale/gs_num.h"
+#include "gs_fastnum.h"
 
 #define CSV_BLOCK (1u << 20)          /* fread block; also the longest line accepted */
 #define CSV_MAX_COLS (2 + 3 * GS_KP_MAX + 1)
@@ -163,6 +164,7 @@ static int csv_getline(gs_kpread *r, const char **s, size_t *n, bool *had_nl, gs
         }
         size_t got = fread(r->buf + r->len, 1, CSV_BLOCK - r->len, r->f);
         r->len += got;
+        r->buf[r->len] = '\0'; /* the sentinel the number scans stop at */
         r->done_bytes += got;
         if (got == 0) {
             if (ferror(r->f)) {
@@ -397,61 +399,63 @@ static gs_kpr_status csv_header(gs_kpread *r, const gs_kpread_opts *opts, gs_kpr
     return GS_KPR_FRAME;
 }
 
-/* Fast exact path for the common "ddd.dd" field: mantissa < 2^53 and at most
- * 22 decimals makes m / 10^k one correctly rounded division (Clinger). */
-static const double pow10_tab[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+static bool parse_number(const char *s, size_t n, double *out) { return gs_fastnum_parse(s, n, out); }
 
-/* [sign] digits [. digits] from p (before e), at most 15 digits: the value to *out,
- * where it stopped to *end; false when no such number starts at p (".5", "-",
- * "abc", "5."). */
-static bool fast_decimal(const char *p, const char *e, const char **end, double *out)
+/* The common row, every field a plain decimal (a frame number plain digits), as
+ * many as the header's, confidences within 0..1 and the time going forward: one
+ * pass into f. false when anything differs: csv_row's general pass then decides,
+ * with its messages, from the start of the row again. s[n] exists and is a line
+ * end or the buffer's sentinel (csv_getline). */
+static bool csv_row_fast(gs_kpread *r, const char *s, size_t n, gs_kpframe *f)
 {
-    bool neg = false;
-    if (p < e && (*p == '-' || *p == '+')) {
-        neg = *p == '-';
-        p++;
-    }
-    uint64_t m = 0;
-    int digits = 0, frac = 0;
-    const char *d0 = p;
-    while (p < e && *p >= '0' && *p <= '9' && digits < 15) {
-        m = m * 10 + (uint64_t)(*p - '0');
-        digits++;
-        p++;
-    }
-    if (p == d0)
-        return false;
-    if (p < e && *p == '.') {
-        p++;
-        const char *f0 = p;
-        while (p < e && *p >= '0' && *p <= '9' && digits < 15) {
-            m = m * 10 + (uint64_t)(*p - '0');
-            digits++;
-            p++;
-        }
-        frac = (int)(p - f0);
-        if (frac == 0)
+    const char *p = s, *e = s + n;
+    double t = NAN, frame = NAN;
+    bool bad_c = false;
+    f->size_px = NAN;
+    int last = r->ncols - 1;
+    for (int c = 0; c <= last; c++) {
+        double d;
+        const char *q = gs_fastnum_scan(p, &d);
+        if (!q || (c < last ? *q != ',' : q != e))
             return false;
+        switch (r->role[c]) {
+        case ROLE_T: t = d; break;
+        case ROLE_FRAME:
+            if (*p < '0' || *p > '9' || memchr(p, '.', (size_t)(q - p)))
+                return false; /* a sign or a fraction: the integer parser's call */
+            frame = d;
+            break;
+        case ROLE_X: f->kp[r->kidx[c]].x_px = (float)d; break;
+        case ROLE_Y: f->kp[r->kidx[c]].y_px = (float)d; break;
+        case ROLE_C: {
+            float cv = (float)d;
+            f->kp[r->kidx[c]].c = cv;
+            bad_c |= !(cv >= 0.0f && cv <= 1.0f);
+            break;
+        }
+        default: f->size_px = (float)d; break;
+        }
+        p = q + 1;
     }
-    double v = (double)m / pow10_tab[frac];
-    *out = neg ? -v : v;
-    *end = p;
+    if (bad_c)
+        return false;
+    if (!r->has_t)
+        t = frame / r->fps;
+    if (r->have_last && !(t > r->last_t))
+        return false;
+    r->last_t = t;
+    r->have_last = true;
+    f->t_s = t;
+    f->frame = r->has_frame ? (uint64_t)frame : r->row;
+    r->row++;
     return true;
-}
-
-static bool parse_number(const char *s, size_t n, double *out)
-{
-    const char *end;
-    if (fast_decimal(s, s + n, &end, out) && end == s + n)
-        return true;
-    return gs_num_parse(s, n, out); /* exponent, long mantissa or junk: the full parser decides */
 }
 
 static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl, gs_kpframe *f,
                              gs_kpread_error *err)
 {
+    if (r->ncols <= CSV_MAX_COLS && csv_row_fast(r, s, n, f))
+        return GS_KPR_FRAME;
     const char *fs[CSV_MAX_COLS];
     size_t fl[CSV_MAX_COLS];
     double val[CSV_MAX_COLS];
@@ -461,7 +465,7 @@ static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl,
     for (;;) {
         const char *q = p;
         bool fast = col < CSV_MAX_COLS && col < r->ncols && r->role[col] != ROLE_FRAME &&
-                    fast_decimal(p, e, &q, &val[col]) && (q == e || *q == ',');
+                    (q = gs_fastnum_scan(p, &val[col])) != NULL && (q == e || *q == ',');
         if (!fast) {
             q = p;
             while (q < e && *q != ',')
@@ -865,7 +869,7 @@ gs_kpread *gs_kpread_open(const char *path, const gs_kpread_opts *opts, gs_kprea
             if (S_ISREG(sb.st_mode))
                 r->total_bytes = (uint64_t)sb.st_size;
         }
-        r->buf = malloc(CSV_BLOCK);
+        r->buf = malloc(CSV_BLOCK + 1); /* + the sentinel */
         if (!r->buf) {
             gs_kpread_fail(err, GS_KPR_EDATA, path, 0, NULL, "out of memory");
             gs_kpread_close(r);
