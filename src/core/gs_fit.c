@@ -30,9 +30,6 @@
 #define GS_FIT_MAD_K GS_R(1.4826)
 /* Bounded work for the robust starts: at most this many sample triples. */
 #define GS_FIT_TRIPLES 60u  /* all-inlier triple among 60 fails with p < 1e-6 at 40 % gross outliers */
-/* The plain start's IRLS that keeps every sample at a scale up to this many noise
- * floors (1.75 for Gaussian noise at the floor) is the fit: no LMS start. */
-#define GS_FIT_CLEAN_SCALE GS_R(3.0)
 /* IRLS stops after this many reweightings even if the weights still move. */
 #define GS_FIT_IRLS_MAX_ITER 10
 /* Fixed PRNG seeds keep every robust fit reproducible. */
@@ -609,10 +606,10 @@ static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
 
 /* Tukey biweight IRLS from a start; *fin (not start) receives the converged curve. */
 static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
-                           gs_fit_result *out, gs_par *fin, gs_real *scale_out)
+                           gs_fit_result *out, gs_par *fin)
 {
     gs_par next;
-    gs_real med, scale = floor_px;
+    gs_real med, scale;
     int it;
     gs_status st;
     bool settled;
@@ -636,7 +633,6 @@ static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_
             break;
         }
     }
-    *scale_out = scale; /* the last weights' */
     return GS_OK;
 }
 
@@ -666,35 +662,31 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
 {
     enum { LMS, PLAIN, N_STARTS };
     gs_par start[N_STARTS], fin;
-    gs_real med, scale, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
+    gs_real med, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
     bool have[N_STARTS];
+    int k;
+    have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
+    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out, NULL) == GS_OK;
+    if (!have[LMS] && !have[PLAIN]) {
+        return GS_EINVAL;
+    }
     /* a fast build keeps the plain run's flags and result (a few words for windows the cache holds) */
     uint32_t plain_keep[GS_FIT_FAST ? GS_FIT_CACHE / 32u : 1u];
     gs_fit_result plain_out;
     uint32_t words = (wn->count + 31u) / 32u, i;
     bool saved = false;
-    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out, NULL) == GS_OK;
-    if (have[PLAIN] && irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin, &scale) == GS_OK) {
-        /* every usable sample kept at a scale near the noise: no gross outlier for the LMS start to escape */
-        if (out->n == m && scale <= GS_FIT_CLEAN_SCALE * floor_px) {
-            return GS_OK;
-        }
-        loss[PLAIN] = tukey_loss(wn, &fin, floor_px);
-        if (GS_FIT_FAST && wn->count <= GS_FIT_CACHE) {
-            for (i = 0; i < words; i++) {
-                plain_keep[i] = keep[i];
+    /* the plain start first: the LMS run, which wins more often, leaves keep and out as its result */
+    for (k = PLAIN; k >= LMS; k--) {
+        if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
+            loss[k] = tukey_loss(wn, &fin, floor_px);
+            if (GS_FIT_FAST && k == PLAIN && have[LMS] && wn->count <= GS_FIT_CACHE) {
+                for (i = 0; i < words; i++) {
+                    plain_keep[i] = keep[i];
+                }
+                plain_out = *out;
+                saved = true;
             }
-            plain_out = *out;
-            saved = true;
         }
-    }
-    have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
-    if (!have[LMS] && !have[PLAIN]) {
-        return GS_EINVAL;
-    }
-    /* the LMS run, which wins more often, leaves keep and out as its result */
-    if (have[LMS] && irls_from(wn, &start[LMS], floor_px, keep, out, &fin, &scale) == GS_OK) {
-        loss[LMS] = tukey_loss(wn, &fin, floor_px);
     }
     if (!(loss[PLAIN] <= loss[LMS])) {
         return loss[LMS] < (gs_real)INFINITY ? GS_OK : GS_EINVAL;
@@ -711,7 +703,7 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
         return GS_OK;
     }
     /* the plain run won: run it again (when the LMS one ran after it) so keep and out hold its weights */
-    return have[LMS] ? irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin, &scale) : GS_OK;
+    return have[LMS] ? irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin) : GS_OK;
 }
 
 static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
