@@ -476,19 +476,25 @@ static NOINLINE uint64_t history_floor(const gs_flight *f)
  * again gets its result, and f->keep still holds its flags (every robust fit in
  * between goes through the memo). */
 typedef struct {
+    bool valid;
+#ifndef __OPTIMIZE_SIZE__
     uint64_t first;
     uint32_t count;
     float min_scale;
     gs_fit_method method;
     gs_status st;
-    bool valid;
     gs_fit_result r;
+#endif
 } fit_memo;
 
 /* gs_fit_robust of ring samples [first, first+count) into f->keep, once per memo */
 static gs_status robust_fit(gs_flight *f, fit_memo *m, uint64_t first, uint32_t count, gs_fit_method method,
                             float min_scale, gs_fit_result *r)
 {
+#ifdef __OPTIMIZE_SIZE__
+    (void)m;  /* the firmware's code budget is full: it fits again */
+    return gs_fit_robust(f->ring, first, count, method, min_scale, f->keep, r);
+#else
     if (m->valid && m->first == first && m->count == count && m->method == method && m->min_scale == min_scale) {
         *r = m->r;
         return m->st;
@@ -501,6 +507,7 @@ static gs_status robust_fit(gs_flight *f, fit_memo *m, uint64_t first, uint32_t 
     m->r = *r;
     m->valid = true;
     return m->st;
+#endif
 }
 
 /* Rebuild the running fit robustly from the ring samples [lo, hi]; *r: its solution
