@@ -670,10 +670,22 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     if (!have[LMS] && !have[PLAIN]) {
         return GS_EINVAL;
     }
+    /* a fast build keeps the plain run's flags and result (a few words for windows the cache holds) */
+    uint32_t plain_keep[GS_FIT_FAST ? GS_FIT_CACHE / 32u : 1u];
+    gs_fit_result plain_out;
+    uint32_t words = (wn->count + 31u) / 32u, i;
+    bool saved = false;
     /* the plain start first: the LMS run, which wins more often, leaves keep and out as its result */
     for (k = PLAIN; k >= LMS; k--) {
         if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
             loss[k] = tukey_loss(wn, &fin, floor_px);
+            if (GS_FIT_FAST && k == PLAIN && have[LMS] && wn->count <= GS_FIT_CACHE) {
+                for (i = 0; i < words; i++) {
+                    plain_keep[i] = keep[i];
+                }
+                plain_out = *out;
+                saved = true;
+            }
         }
     }
     if (!(loss[PLAIN] <= loss[LMS])) {
@@ -681,6 +693,14 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     }
     if (!(loss[PLAIN] < (gs_real)INFINITY)) {
         return GS_EINVAL; /* neither start gave a fit */
+    }
+    if (saved) {
+        /* the plain run won: its flags and result back (whole words: bits past count never changed) */
+        for (i = 0; i < words; i++) {
+            keep[i] = plain_keep[i];
+        }
+        *out = plain_out;
+        return GS_OK;
     }
     /* the plain run won: run it again (when the LMS one ran after it) so keep and out hold its weights */
     return have[LMS] ? irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin) : GS_OK;

@@ -472,15 +472,53 @@ static NOINLINE uint64_t history_floor(const gs_flight *f)
     return f->quiet_from > oldest ? f->quiet_from : oldest;
 }
 
+/* The last robust fit of one decision (a landing and its close): the same window fitted
+ * again gets its result, and f->keep still holds its flags (every robust fit in
+ * between goes through the memo). */
+typedef struct {
+    bool valid;
+#ifndef __OPTIMIZE_SIZE__
+    uint64_t first;
+    uint32_t count;
+    float min_scale;
+    gs_fit_method method;
+    gs_status st;
+    gs_fit_result r;
+#endif
+} fit_memo;
+
+/* gs_fit_robust of ring samples [first, first+count) into f->keep, once per memo */
+static gs_status robust_fit(gs_flight *f, fit_memo *m, uint64_t first, uint32_t count, gs_fit_method method,
+                            float min_scale, gs_fit_result *r)
+{
+#ifdef __OPTIMIZE_SIZE__
+    (void)m;  /* the firmware's code budget is full: it fits again */
+    return gs_fit_robust(f->ring, first, count, method, min_scale, f->keep, r);
+#else
+    if (m->valid && m->first == first && m->count == count && m->method == method && m->min_scale == min_scale) {
+        *r = m->r;
+        return m->st;
+    }
+    m->st = gs_fit_robust(f->ring, first, count, method, min_scale, f->keep, r);
+    m->first = first;
+    m->count = count;
+    m->method = method;
+    m->min_scale = min_scale;
+    m->r = *r;
+    m->valid = true;
+    return m->st;
+#endif
+}
+
 /* Rebuild the running fit robustly from the ring samples [lo, hi]; *r: its solution
  * when true (scratch otherwise). */
-static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r)
+static bool refit_range(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, gs_fit_result *r)
 {
     int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi);
     if (t_lo == GS_T_NONE || t_hi == GS_T_NONE || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    if (gs_fit_robust(f->ring, lo, count, GS_FIT_IRLS, min_scale, f->keep, r) != GS_OK)
+    if (robust_fit(f, m, lo, count, GS_FIT_IRLS, min_scale, r) != GS_OK)
         return false;
     int64_t tspan = t_hi - t_lo;
     gs_fit_init(&f->fit, t_lo + tspan / 2, tspan > 0 ? tspan : frame_dt_us(f));
@@ -495,10 +533,10 @@ static bool refit_range(gs_flight *f, uint64_t lo, uint64_t hi, gs_fit_result *r
 /* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
  * the alarm: if the samples at the edge then sit on the parabola, it was a
  * false alarm (true contact deviates by far more than a refit can absorb). */
-static bool alarm_is_false(gs_flight *f, uint64_t lo, uint64_t hi, uint64_t edge, int side)
+static bool alarm_is_false(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, uint64_t edge, int side)
 {
     gs_fit_result r;
-    if (!refit_range(f, lo, hi, &r)) return false;
+    if (!refit_range(f, m, lo, hi, &r)) return false;
     /* a refit that only fits with a residual far above the noise proves nothing */
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
@@ -530,7 +568,8 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, int64_
         if (hi < newest) hi++;
     }
     gs_fit_result r;
-    if (!refit_range(f, lo, hi, &r)) return false;
+    fit_memo m = {0};
+    if (!refit_range(f, &m, lo, hi, &r)) return false;
     uint32_t n_usable = count_usable(f, lo, hi);
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = r.n >= 5 && 4u * r.n >= 3u * n_usable;
@@ -722,7 +761,7 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
  * Every sample but gross outliers enters the running fit (so a biased early
  * fit corrects itself); the flight's edge is the last sample after which the
  * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end. */
-static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
+static uint64_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
 {
     uint64_t alarm = UINT64_MAX;
     uint32_t outl = 0;
@@ -749,7 +788,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
         outl = 0;
         S = cusum_step(S, z);
         if (S > CUSUM_H && z > CUSUM_K) {
-            if (alarm_is_false(f, i, f->fl_last, i, -1)) {
+            if (alarm_is_false(f, m, i, f->fl_last, i, -1)) {
                 clean = i;
                 f->fl_first = i;
                 S = GS_R(0.0);
@@ -766,7 +805,7 @@ static uint64_t grow_left(gs_flight *f, gs_fit_result *r)
     if (clean != f->fl_first || alarm != UINT64_MAX) {
         f->fl_first = clean;
         gs_fit_result rr;  /* r changes only when the refit succeeds */
-        if (refit_range(f, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, r);
+        if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, r);
     }
     return alarm;
 }
@@ -869,12 +908,12 @@ static NOINLINE void restart_levels(gs_flight *f, uint64_t i)
 
 /* Close the open candidate. right_alarm: the sample at which contact was
  * detected after the flight (UINT64_MAX when it ended otherwise). */
-static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm, bool truncated)
+static void close_candidate(gs_flight *f, fit_memo *m, uint64_t newest, uint64_t right_alarm, bool truncated)
 {
     uint64_t land_idx = UINT64_MAX;  /* first sample after the flight */
     gs_fit_result r;
     if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
-    uint64_t left_alarm = grow_left(f, &r);
+    uint64_t left_alarm = grow_left(f, m, &r);
 
     /* boundary refinement on the up direction of the flight's own acceleration */
     gs_real save_ux = f->up_x, save_uy = f->up_y;
@@ -948,8 +987,7 @@ static void close_candidate(gs_flight *f, uint64_t newest, uint64_t right_alarm,
     uint32_t count = (uint32_t)(in_hi - in_lo + 1);
     gs_fit_result fr;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    gs_status st = gs_fit_robust(f->ring, in_lo, count, f->cfg->fit_method, min_scale,
-                                 f->keep, &fr);
+    gs_status st = robust_fit(f, m, in_lo, count, f->cfg->fit_method, min_scale, &fr);
     trace_fit(f, "final", sf->t_us, sl->t_us, st == GS_OK ? &fr : NULL);
     if (st != GS_OK) goto done;  /* nothing fits: not a flight worth reporting */
 
@@ -1288,8 +1326,9 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_ful
     f->feet_wait_us = GS_T_NONE;
     /* the running fit may hold samples past the edge: rebuild it over the flight */
     gs_fit_result r;
-    refit_range(f, f->fl_first, f->fl_last, &r);
-    close_candidate(f, idx, alarm, false);
+    fit_memo m = {0};
+    refit_range(f, &m, f->fl_first, f->fl_last, &r);
+    close_candidate(f, &m, idx, alarm, false);
     set_state(f, GS_FS_GROUND, s->t_us);
 }
 
@@ -1326,7 +1365,8 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
         return;
     }
     if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
-        if (alarm_is_false(f, f->fl_first, idx, idx, +1)) {
+        fit_memo m = {0};
+        if (alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) {
             f->fl_last = idx;   /* the refit took every sample through idx */
             f->cusum = GS_R(0.0);
             f->pend_ok = 0;
@@ -1368,7 +1408,8 @@ void gs_flight_update(gs_flight *f)
             track_frame_dt(f, dt);
             if (dt > f->max_gap_us) {
                 if (f->state == GS_FS_AIRBORNE) {
-                    close_candidate(f, f->last_idx, UINT64_MAX, true);
+                    fit_memo m = {0};
+                    close_candidate(f, &m, f->last_idx, UINT64_MAX, true);
                 }
                 restart_levels(f, UINT64_MAX);  /* never held: from nothing */
                 set_state(f, GS_FS_GROUND, s->t_us);
@@ -1389,7 +1430,8 @@ static void end_flight(gs_flight *f)
     if (f->state != GS_FS_AIRBORNE) return;
     bool waited = f->feet_wait_us != GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
-    close_candidate(f, f->last_idx, waited ? f->wait_alarm : UINT64_MAX, !waited);
+    fit_memo m = {0};
+    close_candidate(f, &m, f->last_idx, waited ? f->wait_alarm : UINT64_MAX, !waited);
     set_state(f, GS_FS_GROUND, f->last_t_us);
 }
 
