@@ -20,6 +20,7 @@
 #include "gravscale/gs_flight.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #define GS_PI GS_R(3.14159265358979323846)
@@ -637,6 +638,22 @@ static gs_real ssr_left(gs_real yy, const gs_real c[4], const gs_real b[4], int 
     return ssr > GS_R(0.0) ? ssr : GS_R(0.0);
 }
 
+/* The SSR of the piecewise model from its normal equations A c = b (unknowns: the parabola's
+ * three and the contact term's alpha, in tau units), alpha held within [c3_min, c3_max]. */
+static gs_real pw_ssr_solve(gs_real A[4][4], gs_real b[4], gs_real yy, gs_real c3_min, gs_real c3_max)
+{
+    gs_real c[4];
+    bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
+    if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
+    /* alpha at a bound: fit the parabola to u - alpha h */
+    gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
+    gs_real b3[4];
+    for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
+    gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
+    if (!solve_spd(A, b3, 3, c)) return INFINITY;
+    return ssr_left(yy3, c, b3, 3);
+}
+
 /* Weighted SSR of u over samples [lo, hi] under parabola + alpha/2 (T - t)^2 for t < T
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
@@ -672,18 +689,86 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, int64
         }
         yy += w * u * u;
     }
-    gs_real c[4];
-    gs_real c3_min = alpha_min_px * ts2, c3_max = alpha_max_px * ts2;  /* alpha in tau units */
-    bool solved = A[3][3] > GS_R(0.0) && solve_spd(A, b, 4, c);
-    if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
-    /* alpha at a bound: fit the parabola to u - alpha h */
-    gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
-    gs_real b3[4];
-    for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
-    gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
-    if (!solve_spd(A, b3, 3, c)) return INFINITY;
-    return ssr_left(yy3, c, b3, 3);
+    return pw_ssr_solve(A, b, yy, alpha_min_px * ts2, alpha_max_px * ts2);  /* alpha in tau units */
 }
+
+#ifndef __OPTIMIZE_SIZE__
+/* Hosts: the sums of piecewise_ssr that do not depend on T, taken once per boundary. Only
+ * the contact column (h) changes with T, and h is zero short of T, so each grid point adds
+ * the column over the few samples past it, in sample order: the same sums bit for bit
+ * (an added zero leaves a sum as it is). The firmware's code budget is full: it sums anew. */
+#define PW_CACHE 64  /* samples past some grid point (contact samples and the search's reach inside) */
+typedef struct {
+    int64_t t_us;
+    gs_real w, x[3], u;
+} pw_sample;
+typedef struct {
+    gs_real A[3][3], b[3], yy, ts2;
+    uint32_t n;
+    pw_sample s[PW_CACHE];
+} pw_sums;
+
+/* pw's T-independent sums over [lo, hi]; false when more than PW_CACHE samples lie past
+ * T_reach (the grid point reaching furthest into the flight) */
+static bool pw_prepare(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_lo, int64_t t_hi,
+                       int64_t T_reach, int side, const gs_fit_result *r, pw_sums *P)
+{
+    memset(P, 0, offsetof(pw_sums, s));
+    gs_real u_c = GS_R(0.0);
+    bool have_c = sizeof(gs_real) == sizeof(double);
+    gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
+    P->ts2 = ts * ts;
+    for (uint64_t i = lo; i <= hi; i++) {
+        gs_sample_full s_b;
+        gs_real z;
+        const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
+        if (!s) continue;
+        gs_real w = (gs_real)s->w;
+        gs_real tau = gs_time_span_s(s->t_us - t_lo, t_hi - s->t_us) / (ts + ts);
+        gs_real x[3] = {GS_R(1.0), tau, tau * tau};
+        if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
+        gs_real u = (gs_real)u_of(f, s) - u_c;
+        for (int k = 0; k < 3; k++) {
+            P->b[k] += w * x[k] * u;
+            for (int m = 0; m < 3; m++) P->A[k][m] += w * x[k] * x[m];
+        }
+        P->yy += w * u * u;
+        if (past_us(s->t_us, T_reach, side) > 0) {
+            if (P->n == PW_CACHE) return false;
+            pw_sample *c = &P->s[P->n++];
+            c->t_us = s->t_us;
+            c->w = w;
+            memcpy(c->x, x, sizeof x);
+            c->u = u;
+        }
+    }
+    return true;
+}
+
+/* piecewise_ssr at T from the prepared sums */
+static gs_real pw_ssr_at(const pw_sums *P, int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
+{
+    gs_real A[4][4] = {{0}}, b[4] = {0};
+    for (int k = 0; k < 3; k++) {
+        b[k] = P->b[k];
+        for (int m = 0; m < 3; m++) A[k][m] = P->A[k][m];
+    }
+    for (uint32_t j = 0; j < P->n; j++) {
+        const pw_sample *c = &P->s[j];
+        gs_real d = gs_time_span_s(past_us(c->t_us, T, side), 0);
+        if (!(d > GS_R(0.0))) continue;  /* h = 0 */
+        gs_real w = c->w, h = GS_R(0.5) * d * d / P->ts2;
+        gs_real x[4] = {c->x[0], c->x[1], c->x[2], h};
+        b[3] += w * h * c->u;
+        for (int k = 0; k < 3; k++) {
+            A[k][3] += w * x[k] * h;
+            A[3][k] += w * h * x[k];
+        }
+        A[3][3] += w * h * h;
+    }
+    return pw_ssr_solve(A, b, P->yy, alpha_min_px * P->ts2, alpha_max_px * P->ts2);
+}
+#endif
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
  * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
@@ -706,9 +791,24 @@ static int64_t refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int
     gs_real span_s = gs_time_span_s(t_to, t_from);
     gs_real best = INFINITY;
     int64_t best_T = GS_T_NONE;
+#ifndef __OPTIMIZE_SIZE__
+    pw_sums P;
+    int64_t T_reach = GS_T_NONE;  /* the grid point furthest toward the flight */
     for (int k = 0; k <= steps; k++) {
         int64_t T = gs_time_add_s(t_from, span_s * (gs_real)k / (gs_real)steps);
+        if (T == GS_T_NONE) { T_reach = GS_T_NONE; break; }  /* (no grid: the sums anew) */
+        if (k == 0 || past_us(T, T_reach, side) < 0) T_reach = T;
+    }
+    bool prepared = T_reach != GS_T_NONE && pw_prepare(f, lo, hi, t_lo, t_hi, T_reach, side, r, &P);
+#endif
+    for (int k = 0; k <= steps; k++) {
+        int64_t T = gs_time_add_s(t_from, span_s * (gs_real)k / (gs_real)steps);
+#ifndef __OPTIMIZE_SIZE__
+        gs_real ssr = prepared ? pw_ssr_at(&P, T, side, alpha_min_px, alpha_max_px)
+                               : piecewise_ssr(f, lo, hi, t_lo, t_hi, T, side, alpha_min_px, alpha_max_px, r);
+#else
         gs_real ssr = piecewise_ssr(f, lo, hi, t_lo, t_hi, T, side, alpha_min_px, alpha_max_px, r);
+#endif
         /* dropping samples the online test took as flight must pay for itself */
         if (past_us(T, t_in, side) < 0) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
