@@ -490,8 +490,8 @@ double size_of(const ClipResult &r, int track)
 }  // namespace
 
 // 6.87 cm green ball, 1080p30 phone clip, dropped and bouncing (the author's
-// scale 8.09e-4 m/px). The sharp ball measures 88-90 px across, the flights
-// give q = 8.0-8.2e-4: 7.1-7.3 cm, within 5 % (not the 3 %).
+// scale 8.09e-4 m/px, 85 px). Its shadow on the wall darkens the background
+// beside it; the size must stay within 3 % of the truth.
 void test_real_bouncing_ball_ameen(void)
 {
     NEED_CLIP("bouncing_ball_ameen/bounceAmeen.avi", p);
@@ -501,7 +501,7 @@ void test_real_bouncing_ball_ameen(void)
                 r.n_jumps, s, 100.0 * (s / 0.0687 - 1.0));
     TEST_ASSERT_EQUAL(0, r.rc);
     TEST_ASSERT_TRUE(r.n_accepted >= 2);
-    TEST_ASSERT_FLOAT_WITHIN(0.05 * 0.0687, 0.0687, s);
+    TEST_ASSERT_FLOAT_WITHIN(0.03 * 0.0687, 0.0687, s);
 }
 
 // a tennis ball (6.54-6.86 cm) thrown against a wall: 720p30 phone clip (rolling

@@ -406,7 +406,61 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     // the unmixing it would pass for coverage 1 - beta, so coverage also needs the
     // ball's own colour: alpha <= u / (0.35 u_ref), u_ref the ball's typical u
     // (its shading may darken it to 35 % of that before it counts as less ball).
-    cv::Mat uw(roi.size(), CV_32F, cv::Scalar(-1));
+    cv::Mat uw(roi.size(), CV_32F, cv::Scalar(-1)), bw(roi.size(), CV_32F, cv::Scalar(1));
+    // The ball's shadow on the wall darkens the background beside it by a factor
+    // sigma: an edge pixel covered c by the ball then has beta = (1 - c) sigma, and
+    // 1 - beta overstates c there. sigma is read per direction from the pixels
+    // just outside the ball that carry none of its colour, and c = 1 - beta / sigma.
+    auto background_gain = [&](float u_ref) {
+        constexpr int kSect = 16;
+        cv::Mat core = alpha > 0.5f, dist;
+        cv::Moments mo = cv::moments(core, true);
+        if (mo.m00 < 4.0) return;
+        const double cx = mo.m10 / mo.m00, cy = mo.m01 / mo.m00;
+        const double d_core = 2.0 * std::sqrt(mo.m00 / CV_PI);
+        cv::distanceTransform(~core, dist, cv::DIST_L2, 3);
+        // beyond the blur of the edge, and near enough that the shadow is the same
+        const float lo = 3.0f, hi = 3.0f + (float)std::max(3.0, 0.1 * d_core);
+        std::vector<float> sect[kSect];
+        auto sector_of = [&](int x, int y) { return std::atan2(y - cy, x - cx) / (2.0 * CV_PI) * kSect + kSect; };
+        for (int y = 0; y < roi.height; y++) {
+            const float *ur = uw.ptr<float>(y), *br = bw.ptr<float>(y), *dr = dist.ptr<float>(y);
+            for (int x = 0; x < roi.width; x++) {
+                if (!(ur[x] > -0.99f || ur[x] < -1.01f) || dr[x] < lo || dr[x] > hi) continue;
+                if (std::fabs(ur[x]) > 0.1f * u_ref) continue;  // some ball (blur, smear): not the bare background
+                sect[(int)sector_of(x, y) % kSect].push_back(br[x]);
+            }
+        }
+        float sigma[kSect];
+        bool any = false;
+        for (int i = 0; i < kSect; i++) {
+            sigma[i] = 1.0f;
+            if (sect[i].size() < 5) continue;
+            std::vector<float> &v = sect[i];
+            const size_t n = v.size();
+            std::nth_element(v.begin(), v.begin() + (long)(n / 2), v.end());
+            const float med = v[n / 2];
+            for (float &dv : v) dv = std::fabs(dv - med);
+            std::nth_element(v.begin(), v.begin() + (long)(n / 2), v.end());
+            // the median's standard error from the MAD: the wall's texture and the
+            // sensor's noise alone must not pass for a shadow
+            const float se = 1.2533f * 1.4826f * v[n / 2] / std::sqrt((float)n);
+            if (1.0f - med > 3.0f * se) sigma[i] = std::max(0.5f, med);
+            any = any || sigma[i] < 1.0f;
+        }
+        if (!any) return;
+        for (int y = 0; y < roi.height; y++) {
+            const float *ur = uw.ptr<float>(y), *br = bw.ptr<float>(y);
+            float *ar = alpha.ptr<float>(y);
+            for (int x = 0; x < roi.width; x++) {
+                if (!(ur[x] > -0.99f || ur[x] < -1.01f)) continue;
+                double t = sector_of(x, y) - 0.5;  // between the two nearest sectors' centres
+                int i0 = (int)std::floor(t);
+                float f = (float)(t - i0), s = (1.0f - f) * sigma[i0 % kSect] + f * sigma[(i0 + 1) % kSect];
+                ar[x] = std::min(1.5f, std::max(-0.5f, 1.0f - br[x] / s));
+            }
+        }
+    };
     auto compute_alpha = [&](const cv::Vec3f &col) {
         const double cc = col.dot(col);
         std::vector<float> core_u;
@@ -432,6 +486,7 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
                     double u = (bb * ci - cb * bi) / det;       // weight of the ball's colour
                     a = (float)(1.0 - beta);
                     ur[x] = (float)u;
+                    bw.at<float>(y, x) = (float)beta;
                     if (a > 0.8f) core_u.push_back((float)u);
                 } else {
                     a = (iv - br[x]).dot(v) / vv;
@@ -443,6 +498,7 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
         std::nth_element(core_u.begin(), core_u.begin() + (long)(core_u.size() / 2), core_u.end());
         const float u_ref = core_u[core_u.size() / 2];
         if (!(u_ref > 0.2f)) return;
+        background_gain(u_ref);
         const float inv_u = 1.0f / (0.35f * u_ref);
         for (int y = 0; y < roi.height; y++) {
             float *ar = alpha.ptr<float>(y);
