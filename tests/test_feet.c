@@ -113,8 +113,8 @@ static void test_toes_clean_every_phase(void)
             /* the toe accelerates up through its crossing: the chord between the frames
              * around it crosses early, by up to 0.3 of a frame interval */
             TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.15 / fpss[fi] + 0.0005, p.t0 - 0.15 / fpss[fi], t0 * 1e-6, msg);
-            /* the touch is interpolated linearly between the last falling frame and the first
-             * stopped one, across the impact: late by up to a third of a frame interval */
+            /* the touch follows the toe down from its last frame clear of the floor at its
+             * speed there: late by up to a third of a frame interval */
             TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.17 / fpss[fi] + 0.001, p.t1 + 0.16 / fpss[fi], t1 * 1e-6, msg);
             TEST_ASSERT_FLOAT_WITHIN_MESSAGE(0.5f, (float)-FLOOR_Y, lv, msg);
             TEST_ASSERT_FLOAT_WITHIN_MESSAGE(0.5f, (float)-FLOOR_Y, on, msg);

@@ -59,7 +59,9 @@ static void test_gym_handheld_flight_time_and_warning(void)
     double ft = num(j, "flight_time_s");
     std::printf("gym clip: flight %.4f s (app 0.789 s), jump height %.3f m (app 0.763), %s\n", ft,
                 num(j, "jump_height_m"), j.substr(j.find("\"warnings\"")).c_str());
-    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(2.0 / 29.96, 0.789, ft, "flight time within 2 frames of the app's");
+    // the app's flight time to half a frame, and its jump height (g T^2 / 8) to 2 cm
+    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.017, 0.789, ft, "flight time within half a frame of the app's");
+    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.02, 0.7634, num(j, "jump_height_m"), "jump height within 2 cm of the app's");
     bool accepted = j.find("\"accepted\":true") != std::string::npos;
     bool warned = j.find("\"camera_moved\"") != std::string::npos;
     TEST_ASSERT_TRUE_MESSAGE(!accepted || warned, "a height from a moving camera carries camera_moved");
@@ -70,7 +72,8 @@ static void test_gym_handheld_flight_time_and_warning(void)
     TEST_ASSERT_EQUAL_INT(2, (int)ses.size());
     TEST_ASSERT_DOUBLE_WITHIN(1e-3, ft, num(ses[1], "best_flight_s"));
     TEST_ASSERT_TRUE_MESSAGE(j.find("\"com_timed\"") == std::string::npos, "the flight is timed by the feet");
-    // the fallback engine's keypoints differ by a few pixels: the feet time the same flight
+    // the fallback engine's keypoints differ by a few pixels (10 px at the impact's blurred
+    // frame): the feet time the same flight, to a third of a frame
     Run rc = run("'" + clip + "' --detector pose --engine opencv");
     TEST_ASSERT_EQUAL_INT(0, rc.code);
     auto jc = lines_of(rc.out, "jump");
@@ -78,7 +81,8 @@ static void test_gym_handheld_flight_time_and_warning(void)
     std::printf("gym clip, OpenCV DNN: flight %.4f s, %s\n", num(jc[0], "flight_time_s"),
                 jc[0].substr(jc[0].find("\"warnings\"")).c_str());
     TEST_ASSERT_TRUE_MESSAGE(jc[0].find("\"com_timed\"") == std::string::npos, "OpenCV DNN: timed by the feet");
-    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.005, ft, num(jc[0], "flight_time_s"), "both engines, one flight time");
+    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.011, ft, num(jc[0], "flight_time_s"), "both engines, one flight time");
+    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.017, 0.789, num(jc[0], "flight_time_s"), "OpenCV DNN: the app's flight time");
 }
 
 static void test_vtest_people_walking_report_nothing(void)

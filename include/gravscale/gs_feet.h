@@ -6,9 +6,10 @@
  * level (the height the point stands above its rest at the instant the foot leaves: a toe
  * rolls up on its tip, an ankle rides a plantarflexed foot) and the crossing is
  * interpolated between the frames around it. A touch is the mirror image: for toes where
- * the falling point is stopped by the floor (its level then known from the stop), for
- * ankles where the falling point passes its take-off level again (the heel comes down
- * only later). The latest lifts and touches are kept with their levels for the flight
+ * the falling point is stopped by the floor (its level then known from the stop; the
+ * instant from its speed in the air below the last frame surely above the floor, as the
+ * interval around the impact mixes the fall with the standstill), for ankles where the
+ * falling point passes its take-off level again (the heel comes down only later). The latest lifts and touches are kept with their levels for the flight
  * module, which picks those around each flight (gs_feet_takeoff, gs_feet_landing).
  * No heap; about 200 bytes. */
 #ifndef GS_FEET_H

@@ -19,6 +19,8 @@
 #define RECROSS GS_WITH_COCO17
 #define NOISE_K     3.0f   /* margins at least this many of the point's own jitter */
 #define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
+#define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
+#define LAND_G_REL  5.8f   /* gravity in statures per s^2 (9.81 m/s^2 over a 1.7 m body): a landing foot's fall */
 
 static bool fin(float v) { return v == v && v - v == 0.0f; }
 
@@ -84,6 +86,52 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
         newer = b;
     }
     return GS_T_NONE;
+}
+
+/* The newest downward crossing of level L by a point the floor stops there (a toe landing),
+ * placed by its speed in the air. The floor halts it within the frame interval around the
+ * impact, so a straight line through that interval puts the landing late (the interval's
+ * mean speed mixes the fall with the standstill). Frames within margin (the point's noise)
+ * of L, or braked harder than a foot in the air is, may already touch, or be a blurred mix
+ * of both: from the last frame surely above them the point falls on to L from its speed
+ * between that frame and the one before, accelerating as a body falls, and reaches L no
+ * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
+static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
+{
+    uint32_t bk[GS_FEET_HIST];  /* finite frames, newest first (a missing or outlier frame is bridged) */
+    unsigned n = 0;
+    for (uint32_t b = 0; b < held(ft); b++)
+        if (fin(f->u_px[slot(ft, b)])) bk[n++] = b;
+    unsigned c = n;  /* the first frame at L after the newest crossing */
+    for (unsigned i = 0; i + 1 < n && c == n; i++)
+        if (f->u_px[slot(ft, bk[i + 1])] > L && f->u_px[slot(ft, bk[i])] <= L) c = i;
+    if (c == n) return GS_T_NONE;
+    unsigned a = c;  /* the last frame surely in the air before it: clear of L, and not braked */
+    for (unsigned i = c + 1; i < n; i++) {
+        float u = f->u_px[slot(ft, bk[i])];
+        if (!(u > L)) break;  /* (an earlier dip: no clear bracket) */
+        if (!(u > L + margin)) continue;
+        if (i + 2u < n) {  /* a fall into it under half the one before is no free fall: the impact's blur */
+            float u1 = f->u_px[slot(ft, bk[i + 1u])], u2 = f->u_px[slot(ft, bk[i + 2u])];
+            float t0 = (float)age_us(ft, bk[i]), t1 = (float)age_us(ft, bk[i + 1u]), t2 = (float)age_us(ft, bk[i + 2u]);
+            if ((u1 - u) * BRAKE_RATIO * (t2 - t1) < (u2 - u1) * (t1 - t0)) continue;
+        }
+        a = i;
+        break;
+    }
+    if (a == c) return crossing_us(ft, f, L, false);
+    float ua = f->u_px[slot(ft, bk[a])];
+    float ta = (float)age_us(ft, bk[a]) * 1e-6f, tc = (float)age_us(ft, bk[c]) * 1e-6f;  /* s before the newest */
+    float tau = (ta - tc) * (ua - L) / (ua - f->u_px[slot(ft, bk[c])]);  /* the chord's: the latest */
+    if (a + 1u < n) {
+        /* falling on from its speed between a and the frame before, as a body falls */
+        float g = LAND_G_REL * size_px, tb = (float)age_us(ft, bk[a + 1u]) * 1e-6f;
+        float v = (f->u_px[slot(ft, bk[a + 1u])] - ua) / (tb - ta) + 0.5f * g * (tb - ta);
+        float disc = v * v + 2.0f * g * (ua - L);
+        float tq = disc >= 0.0f ? (sqrtf(disc) - v) / g : NAN;
+        if (tq >= 0.0f && tq < tau) tau = tq;
+    }
+    return ft->t_last_us - (int32_t)((ta - tau) * 1e6f + 0.5f);  /* (int32: no 64-bit conversion on the target) */
 }
 
 /* the median of the point's heights `back`, `back`+1 and `back`+2 frames before the newest
@@ -164,7 +212,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (!(vf < v1)) vf = v1;
     if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
         (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
-        int64_t tc = crossing_us(ft, f, u + d, false);
+        int64_t tc = landing_us(ft, f, u + d, margin, size_px);
         if (tc != GS_T_NONE) {
             log_event(f->touch, tc, u, f->floor_px);
             f->touch_unsure = 1;
