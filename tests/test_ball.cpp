@@ -568,8 +568,10 @@ void test_real_tilted_drop_right_or_rejected(void)
     TEST_ASSERT_TRUE(!std::isfinite(s) || (s > 0.0654 * 0.95 && s < 0.0686 * 1.05));
 }
 
-// three alike juggling balls at 324x240: every size found is a juggling ball's
-// (4-9 cm), and they agree within 10 % (the issue asks 5 %; not reached)
+// three alike juggling balls at 324x240: a 15 px ball's centre scatters more
+// than 3 % of its size, so flights within the clip's centre noise stand (4 of 12
+// at least); every size found is a juggling ball's (4-9 cm), and they agree
+// within 10 % (the issue asks 5 %; not reached: 6.03 and 6.35 cm)
 void test_real_juggling_sizes_agree(void)
 {
     NEED_CLIP("juggling_3balls_lowres/juggling_low_quality.mp4", p);
@@ -586,6 +588,8 @@ void test_real_juggling_sizes_agree(void)
     TEST_ASSERT_TRUE_MESSAGE(hi > 0, "a juggling ball measured");
     // a ball caught and thrown has no take-off from the floor: its rise, contact and RSI are unknown
     TEST_ASSERT_EQUAL_MESSAGE(0, r.n_unknown_as_number, "a jump without a take-off velocity gives no rise, contact or RSI");
+    std::printf("juggling: %d/%d flights accepted\n", r.n_accepted, r.n_jumps);
+    TEST_ASSERT_TRUE_MESSAGE(r.n_accepted >= 4, "the flights within the centre noise accepted");
     TEST_ASSERT_TRUE(hi / lo - 1.0 <= 0.10);
 }
 
