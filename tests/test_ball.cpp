@@ -569,14 +569,16 @@ void test_real_tilted_drop_right_or_rejected(void)
 }
 
 // three alike juggling balls at 324x240: every size found is a juggling ball's
-// (4-9 cm), and they agree within 10 % (the issue asks 5 %; not reached)
+// (4-9 cm), at least two balls are sized, and they agree within 5 %
 void test_real_juggling_sizes_agree(void)
 {
     NEED_CLIP("juggling_3balls_lowres/juggling_low_quality.mp4", p);
     ClipResult r = run_program(p);
     double lo = 1e9, hi = -1e9;
+    int sized = 0;
     for (const auto &kv : r.size) {
         if (!std::isfinite(kv.second)) continue;
+        sized++;
         std::printf("juggling: track %d diameter %.4f m\n", kv.first, kv.second);
         lo = std::min(lo, kv.second);
         hi = std::max(hi, kv.second);
@@ -586,7 +588,10 @@ void test_real_juggling_sizes_agree(void)
     TEST_ASSERT_TRUE_MESSAGE(hi > 0, "a juggling ball measured");
     // a ball caught and thrown has no take-off from the floor: its rise, contact and RSI are unknown
     TEST_ASSERT_EQUAL_MESSAGE(0, r.n_unknown_as_number, "a jump without a take-off velocity gives no rise, contact or RSI");
-    TEST_ASSERT_TRUE(hi / lo - 1.0 <= 0.10);
+    std::printf("juggling: %d/%d flights accepted\n", r.n_accepted, r.n_jumps);
+    TEST_ASSERT_TRUE_MESSAGE(r.n_accepted >= 4, "the flights within the centre noise accepted");
+    TEST_ASSERT_TRUE_MESSAGE(sized >= 2, "at least two balls sized");
+    TEST_ASSERT_TRUE(hi / lo - 1.0 <= 0.05);
 }
 
 // the robustness clips (portrait, blur, dropped frames, a multicoloured ball with

@@ -27,6 +27,12 @@ constexpr double kEdgeRel = 0.005;
 constexpr double kEdgePx = 0.15;
 // the widest lens assumed: a focal length of at least 0.35 x the frame's longer side
 constexpr double kFocalMinRel = 0.35;
+// the clip's centre noise is estimated from this many windows of four detections on
+constexpr size_t kNoiseMinWindows = 8;
+// overlapping windows and their median: about this many degrees of freedom each (simulated)
+constexpr double kNoiseDofPerWindow = 0.55;
+// a parabola's residual beyond the centre noise at this significance
+constexpr double kResidualP = 0.001;
 
 double median_of(std::vector<double> v)
 {
@@ -45,6 +51,61 @@ Parabola fit_obs(const std::vector<BallObs> &pts)
 }
 
 bool debug() { return std::getenv("GS_BALL_DEBUG") != nullptr; }
+
+// the first and last detections may be contact (release, impact, another ball
+// taken for this one): out when they leave the others' parabola
+void trim_contact_ends(std::vector<BallObs> &pts, Parabola &fit)
+{
+    for (int end = 0; end < 2 && pts.size() > 5; end++) {
+        std::vector<BallObs> rest(pts.begin() + (end == 0 ? 1 : 0), pts.end() - (end == 1 ? 1 : 0));
+        Parabola f2 = fit_obs(rest);
+        const BallObs &o = end == 0 ? pts.front() : pts.back();
+        double e = std::hypot(f2.x(o.t_s) - o.x_px, f2.y(o.t_s) - o.y_px);
+        if (f2.ok && e > std::max(1.0, 4.0 * f2.rms_px)) {
+            pts = rest;
+            fit = f2;
+        }
+    }
+}
+
+// the regularised incomplete beta function I_x(a, b) (continued fraction, modified Lentz)
+double inc_beta(double a, double b, double x)
+{
+    if (!(x > 0.0)) return 0.0;
+    if (!(x < 1.0)) return 1.0;
+    if (x > (a + 1.0) / (a + b + 2.0)) return 1.0 - inc_beta(b, a, 1.0 - x);
+    double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x)) / a;
+    const double tiny = 1e-300;
+    double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
+    d = 1.0 / (std::fabs(d) < tiny ? tiny : d);
+    double h = d;
+    for (int m = 1; m <= 300; m++) {
+        for (int odd = 0; odd < 2; odd++) {
+            double num = odd ? -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
+                             : m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m));
+            d = 1.0 + num * d;
+            d = 1.0 / (std::fabs(d) < tiny ? tiny : d);
+            c = 1.0 + num / c;
+            if (std::fabs(c) < tiny) c = tiny;
+            h *= c * d;
+        }
+        if (std::fabs(c * d - 1.0) < 1e-12) break;
+    }
+    return front * h;
+}
+
+// the F(n1, n2) distribution's upper p quantile (bisection on its CDF)
+double f_upper_quantile(double p, double n1, double n2)
+{
+    double lo = 0.0, hi = 1.0;
+    auto cdf = [&](double f) { return inc_beta(0.5 * n1, 0.5 * n2, n1 * f / (n1 * f + n2)); };
+    while (cdf(hi) < 1.0 - p && hi < 1e12) hi *= 2.0;
+    for (int i = 0; i < 100; i++) {
+        double mid = 0.5 * (lo + hi);
+        (cdf(mid) < 1.0 - p ? lo : hi) = mid;
+    }
+    return hi;
+}
 
 }  // namespace
 
@@ -86,12 +147,64 @@ void BallFlights::add(const BallObs &o)
         a.fit = Parabola();
     }
     a.pts.push_back(o);
+    // the centre's noise: a third divided difference is zero for any parabola, so
+    // four consecutive detections of one arc show only their scatter (the arc's
+    // first, the one the last parabola did not explain, is often contact: left out)
+    if (a.pts.size() >= 5 && a.pts.back().frame == a.pts[a.pts.size() - 4].frame + 3) {
+        const BallObs *q = &a.pts[a.pts.size() - 4];
+        double dx = 0.0, dy = 0.0, w2 = 0.0, dsum = 0.0;
+        int nd = 0;
+        for (int i = 0; i < 4; i++) {
+            double w = 1.0;
+            for (int k = 0; k < 4; k++)
+                if (k != i) w /= q[i].t_s - q[k].t_s;
+            dx += w * q[i].x_px;
+            dy += w * q[i].y_px;
+            w2 += w * w;
+            if (std::isfinite(q[i].diameter_px)) {
+                dsum += q[i].diameter_px;
+                nd++;
+            }
+        }
+        // per axis: sigma^2 times an exponential; times the diameter, the edge's noise (size-free)
+        double v = 0.5 * (dx * dx + dy * dy) / w2;
+        if (nd >= 2 && std::isfinite(v)) centre_noise_.push_back(v * dsum / nd);
+        if (centre_noise_.size() > 8192) centre_noise_.erase(centre_noise_.begin(), centre_noise_.begin() + 2048);
+    }
     if (a.pts.size() >= 3) {
         // the newest points predict (a bounce far back must not bend the prediction)
         size_t n = std::min<size_t>(a.pts.size(), 30);
         std::vector<BallObs> last(a.pts.end() - (long)n, a.pts.end());
         a.fit = fit_obs(last);
     }
+}
+
+// The centroid's variance per axis for a ball d px across: an edge of pi d pixels
+// with independent noise moves it by 2 sigma_edge^2 / (pi d), so the clip's measured
+// scatter times its diameters, over d (NaN until measured)
+double BallFlights::centre_var_px2(double d_px) const
+{
+    if (!(d_px > 0) || centre_noise_.size() < kNoiseMinWindows) return NAN;
+    // an exponential's median is ln 2 of its mean
+    return median_of(centre_noise_) / std::log(2.0) / d_px;
+}
+
+// The core's limit (a share of the size), or a parabola's residual (per axis, n
+// detections, 3 coefficients each) the centre noise explains: their variances' ratio
+// is F(2 (n - 3), the noise estimate's degrees of freedom) for a true parabola.
+// Never below a hard edge's quantisation noise, 1 / (6 pi d) px^2.
+bool BallFlights::residual_ok(double rms_px, size_t n, double d_px) const
+{
+    if (rms_px <= opt_.core.max_rms_rel * d_px) return true;
+    double var = centre_var_px2(d_px);
+    if (n < 4 || !std::isfinite(var) || !(rms_px >= 0.0)) return false;
+    var = std::max(var, 1.0 / (6.0 * M_PI * d_px));
+    double nu = 2.0 * ((double)n - 3.0), nu_noise = kNoiseDofPerWindow * (double)centre_noise_.size();
+    double lim = f_upper_quantile(kResidualP, nu, nu_noise);
+    if (debug())
+        std::fprintf(stderr, "      residual %.3f px, centre noise %.3f px (%zu windows), limit %.3f px\n", rms_px,
+                     std::sqrt(var), centre_noise_.size(), std::sqrt(lim * var));
+    return rms_px * rms_px <= lim * var;
 }
 
 // A closed arc with no apex inside (dropped from rest, entered falling, left
@@ -275,7 +388,26 @@ void BallFlights::judge(gs_ev_jump *j)
     for (const BallObs &o : ts.obs)
         if (o.t_s > t0 && o.t_s < t1) in.push_back(o);
     Parabola fit = fit_obs(in);
+    // (the core leaves such detections out of its fit too: its outliers)
+    if (j->n_outliers > 0) trim_contact_ends(in, fit);
     FlightSize fs = measure(in, fit, j->a_px_s2);
+    // The core's residual limit is a share of the size; a small ball's centroid
+    // scatters more than that, so the clip's centre noise decides, then the core's
+    // later rules (the acceleration sure, along gravity within 45 degrees). The
+    // core's RMS is over both axes and its n inliers: per axis, 3 coefficients each.
+    double n_core = (double)j->n_samples;
+    double rms_axis = n_core > 3 ? j->rms_px * std::sqrt(n_core / (2.0 * (n_core - 3.0))) : NAN;
+    if (!j->accepted && j->reason == GS_REJ_LARGE_RESIDUAL && fs.ok && fit.ok && std::isfinite(rms_axis) &&
+        residual_ok(rms_axis, j->n_samples, fs.size_px)) {
+        double amag = std::hypot(fit.ax, fit.ay);
+        bool down = amag > 0 && fit.ay / amag > std::cos(M_PI / 4.0);
+        bool a_sure = std::hypot(j->a_px_se_s2 / j->a_px_s2, fs.a_sys_rel) <= opt_.core.max_a_se_rel;
+        if (debug()) std::fprintf(stderr, "      within the centre noise: %s\n", down && a_sure ? "stands" : "still out");
+        if (down && a_sure) {
+            j->accepted = true;
+            j->reason = GS_REJ_NONE;
+        }
+    }
     // One parabola must explain the flight's detections: where the track's own
     // parabola broke inside the window (a hand caught or pushed the ball: a dribble)
     // with detections on both sides, the core's fit joins two motions
@@ -341,20 +473,9 @@ void BallFlights::judge(gs_ev_jump *j)
 
 bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
 {
-    // the first and last detections may be contact (release, impact): out when they
-    // leave the others' parabola
     std::vector<BallObs> pts = a0.pts;
     Parabola fit = fit_obs(pts);
-    for (int end = 0; end < 2 && pts.size() > 5; end++) {
-        std::vector<BallObs> rest(pts.begin() + (end == 0 ? 1 : 0), pts.end() - (end == 1 ? 1 : 0));
-        Parabola f2 = fit_obs(rest);
-        const BallObs &o = end == 0 ? pts.front() : pts.back();
-        double e = std::hypot(f2.x(o.t_s) - o.x_px, f2.y(o.t_s) - o.y_px);
-        if (f2.ok && e > std::max(1.0, 4.0 * f2.rms_px)) {
-            pts = rest;
-            fit = f2;
-        }
-    }
+    trim_contact_ends(pts, fit);
     if (!fit.ok) return false;
     double amag = std::hypot(fit.ax, fit.ay);
     if (!(amag > 0)) return false;
@@ -396,7 +517,7 @@ bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
         j->reason = GS_REJ_GAP;
     else if (!fs.ok)
         j->reason = GS_REJ_NO_SIZE;
-    else if (fit.rms_px > c.max_rms_rel * fs.size_px)
+    else if (!residual_ok(fit.rms_px, pts.size(), fs.size_px))
         j->reason = GS_REJ_LARGE_RESIDUAL;
     else if (!(std::hypot(j->a_px_se_s2 / amag, fs.a_sys_rel) <= c.max_a_se_rel))
         j->reason = GS_REJ_UNCERTAIN_A;

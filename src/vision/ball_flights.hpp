@@ -14,6 +14,9 @@
 //    cannot follow (an acceleration that changes along the flight beyond what
 //    air drag can do: a camera tilted toward the fall, motion in depth) is
 //    rejected as not_planar;
+//  * the residual's limit: the core's share of the size, or the centre noise the
+//    clip's own detections show for a ball of this size when that is larger (a
+//    small ball's centroid is noisier than a fixed share of its size);
 //  * flights the core cannot seed: the core starts a flight at an apex, so a
 //    ball dropped from rest (or one that leaves the frame before its apex) is
 //    found here, as a parabola over the track's detections between two breaks,
@@ -97,6 +100,8 @@ private:
     FlightSize measure(const std::vector<BallObs> &pts, const Parabola &fit, double a_px_s2);
     bool flight_from_arc(int track, const Arc &a, gs_ev_jump *j);
     double frame_dt(const std::vector<BallObs> &pts) const;
+    double centre_var_px2(double d_px) const;
+    bool residual_ok(double rms_px, size_t n, double d_px) const;
 
     BallFlightsOptions opt_;
     std::map<int, TrackState> tracks_;
@@ -106,6 +111,7 @@ private:
     double rs_k_ = 0.0;
     int n_tested_ = 0, n_not_planar_ = 0;  // flights the geometry test ran on, and failed
     std::vector<double> psf_seen_;  // the blur's variance from each clean detection (px^2)
+    std::vector<double> centre_noise_;  // per 4 consecutive detections: centre variance x diameter (px^3)
 };
 
 }  // namespace gs
