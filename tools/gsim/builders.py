@@ -5,6 +5,8 @@ import math
 from . import body
 from .motion import Motion, Contact, Flight, Infeasible, G, D2R
 
+A_FREE = -G  # COM acceleration where a contact begins or ends: the ground force is zero there (force plates)
+
 S_STAND = 0.06   # relaxed knees when standing (flexion units, ~6.6 deg at the knee)
 
 
@@ -254,7 +256,7 @@ class Builder:
         self.key(t0, lean=0.0, hp=p_to["hp"], ph_L=(ph_to, r_ph), ph_R=(ph_to, r_ph),
                  af_L=(arm_to + dl, ra), af_R=(arm_to - dl, ra), el_L=p_to["el_L"], el_R=p_to["el_R"])
         m.z.add_quintic(ta, tb, self.z_st, 0.0, 0.0, zb, 0.0, ab)
-        m.z.add_quintic(tb, t0, zb, 0.0, ab, z_to, v0, u(-0.5, -0.05) * G)
+        m.z.add_quintic(tb, t0, zb, 0.0, ab, z_to, v0, A_FREE)
         vxy = self.flight_drift(0.06 if sym else 0.12)
         db = (self.d[0] + g(0, 0.01), self.d[1] + g(0, 0.01))
         dto = (self.d[0] + g(0, 0.01), self.d[1] + g(0, 0.01))
@@ -305,7 +307,7 @@ class Builder:
         td = tc + u(0.5, 0.9)
         # bounded so the rise back to standing does not overshoot the standing height
         ac = min(u(0.3, 1.0) * G, 4.0 * (self.z_st - z_abs) / (td - tc) ** 2)
-        m.z.add_quintic(tL, tc, zL, vL, u(1.5, 4.0) * G, z_abs, 0.0, ac)
+        m.z.add_quintic(tL, tc, zL, vL, A_FREE, z_abs, 0.0, ac)
         m.z.add_quintic(tc, td, z_abs, 0.0, ac, self.z_st, 0.0, 0.0)
         dmid = (self.dbal[0] + g(0, 0.01), self.dbal[1] + g(0, 0.01))
         self.hpiece(c, tL, tc, dL, vLxy, dmid, (0, 0))
@@ -343,7 +345,7 @@ class Builder:
         r_ph = u(5, 9)
         self.key(t0, ph_L=(ph_c, r_ph), ph_R=(ph_c, r_ph), lean=0.0)
         m.z.add_quintic(ta, tb, self.z_st, 0.0, 0.0, zb, 0.0, ab)
-        m.z.add_quintic(tb, t0, zb, 0.0, ab, z_to, v0, u(-0.4, 0.0) * G)
+        m.z.add_quintic(tb, t0, zb, 0.0, ab, z_to, v0, A_FREE)
         vxy = self.flight_drift(0.04)
         self.hpiece(ph, ta, t0, self.d, (0, 0), self.d, vxy)
         self.check(ta, t0)
@@ -378,7 +380,7 @@ class Builder:
             p_to = m.pose(t1)
             z0, dx, dy = self.natural(p_to, c, s_to)
             vxy = self.flight_drift(0.04)
-            m.z.add_quintic(tL, t1, zL, vL, u(1.5, 3.0) * G, z0, vz, u(-0.4, 0.0) * G)
+            m.z.add_quintic(tL, t1, zL, vL, A_FREE, z0, vz, A_FREE)
             self.hpiece(c, tL, t1, dL, vLxy, (dx + g(0, 0.005), dy + g(0, 0.005)), vxy)
             self.check(tL, t1)
             t0 = t1
@@ -390,7 +392,7 @@ class Builder:
         td = tc + u(0.4, 0.8)
         # bounded so the rise back to standing does not overshoot the standing height
         ac = min(u(0.3, 1.0) * G, 4.0 * (self.z_st - z_abs) / (td - tc) ** 2)
-        m.z.add_quintic(tL, tc, zL, vL, u(1.5, 3.0) * G, z_abs, 0.0, ac)
+        m.z.add_quintic(tL, tc, zL, vL, A_FREE, z_abs, 0.0, ac)
         m.z.add_quintic(tc, td, z_abs, 0.0, ac, self.z_st, 0.0, 0.0)
         self.hpiece(c, tL, td, dL, vLxy, self.dbal, (0, 0))
         self.d = self.dbal
