@@ -146,8 +146,9 @@ typedef struct {
     gs_real c[6];
 } gs_par;
 
-/* gs_fit_solve, and on success the tau-basis parabola to *p (when p is not NULL). */
-static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
+/* gs_fit_solve, and on success the tau-basis parabola to *p (when p is not NULL); with
+ * base, f fitted the samples less base: base is added back. */
+static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const gs_par *base)
 {
     gs_par par;
     gs_real *cx = &par.c[0], *cy = &par.c[3], col[3], ts, ts2, ssr;
@@ -173,6 +174,9 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
     }
     back_sub(f->r, f->zx, cx);
     back_sub(f->r, f->zy, cy);
+    for (k = 0; base && k < 6; k++) {
+        par.c[k] += base->c[k];
+    }
     ts = f->tscale_s;
     ts2 = ts * ts;
     {
@@ -206,7 +210,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p)
 
 gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
 {
-    return solve_par(f, out, NULL);
+    return solve_par(f, out, NULL, NULL);
 }
 
 const char *gs_fit_method_name(gs_fit_method m)
@@ -503,25 +507,105 @@ static float sample_weight(const gs_fsamp *s, const gs_par *p, w_mode mode, gs_r
     return (float)((gs_real)s->w * tukey(r, cut));
 }
 
+/* The fit of the weighted sums of the samples less a base curve: the 3x3 Gram matrix
+ * G = sum w (1, tau, tau^2)^T (1, tau, tau^2) and b = sum w e (1, tau, tau^2) per axis.
+ * Its Cholesky factor is the R of the Givens QR (both upper triangular with a positive
+ * diagonal, R^T R = G) and R^-T b its z, so solve_par reads it like a streamed fit. */
+typedef struct {
+    gs_real g[5];      /* sum w tau^k, k = 0..4 */
+    gs_real b[2][3];   /* sum w e tau^k per axis, k = 0..2 */
+    gs_real ee[2];     /* sum w e^2 per axis */
+    uint32_t n;
+} gs_wsums;
+
+static void wsums_add(gs_wsums *a, gs_real tau, gs_real ex, gs_real ey, gs_real w)
+{
+    gs_real wt = w;  /* w tau^k */
+    int k;
+    a->ee[0] += w * ex * ex;
+    a->ee[1] += w * ey * ey;
+    for (k = 0; k < 5; k++) {
+        a->g[k] += wt;
+        if (k < 3) {
+            a->b[0][k] += wt * ex;
+            a->b[1][k] += wt * ey;
+        }
+        wt *= tau;
+    }
+    a->n++;
+}
+
+/* The sums into the fit f (started at the window's centre and scale); a singular G
+ * leaves a zero or NaN diagonal that solve_par refuses. */
+static void wsums_to_fit(const gs_wsums *a, gs_fit *f)
+{
+    gs_real *r = f->r, d;
+    int axis;
+    if (a->n == 0u) {
+        return;
+    }
+    r[0] = sqrt(a->g[0]);
+    r[1] = a->g[1] / r[0];
+    r[2] = a->g[2] / r[0];
+    d = a->g[2] - r[1] * r[1];
+    r[3] = d > GS_R(0.0) ? sqrt(d) : GS_R(0.0);
+    r[4] = (a->g[3] - r[1] * r[2]) / r[3];
+    d = a->g[4] - r[2] * r[2] - r[4] * r[4];
+    r[5] = d > GS_R(0.0) ? sqrt(d) : GS_R(0.0);
+    for (axis = 0; axis < 2; axis++) {
+        const gs_real *b = a->b[axis];
+        gs_real *z = axis == 0 ? f->zx : f->zy, ssr;
+        z[0] = b[0] / r[0];
+        z[1] = (b[1] - r[1] * z[0]) / r[3];
+        z[2] = (b[2] - r[2] * z[0] - r[4] * z[1]) / r[5];
+        /* what the fit leaves of the sum of squares (small: e is taken about a near curve) */
+        ssr = a->ee[axis] - (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
+        *(axis == 0 ? &f->ssr_x : &f->ssr_y) = ssr > GS_R(0.0) ? ssr : GS_R(0.0);
+    }
+    f->sum_w = a->g[0];
+    f->n = a->n;
+}
+
 /* Weighted LS over the window; flags each sample with a positive weight in keep, the
- * tau-basis parabola to p. r2: the samples' squared residuals from model, or NULL. */
+ * tau-basis parabola to p. r2: the samples' squared residuals from model, or NULL.
+ * In double the normal equations (sums about model, when there is one) lose nothing
+ * and cost a fraction of the Givens rows; in float (the firmware) the rows keep the
+ * fit accurate in single precision. */
 static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, uint32_t *keep,
                             gs_par *p, gs_fit_result *out, const gs_real *r2)
 {
     gs_fit f;
+    gs_wsums a;
+    gs_par base;
     uint32_t i;
+    memset(&a, 0, sizeof a);
+    memset(&base, 0, sizeof base);
+    if (model && !GS_REAL_IS_FLOAT) {
+        base = *model;
+    }
     fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
         float w = s ? sample_weight(s, model, mode, cut, GS_FIT_FAST && r2 && i < GS_FIT_CACHE ? &r2[i] : NULL) : 0.0f;
         keep_set(keep, i, w > 0.0f);
-        if (w > 0.0f) {
+        if (!(w > 0.0f)) {
+            continue;
+        }
+        if (GS_REAL_IS_FLOAT) {
             /* as gs_fit_add would: the fit shares the window's centre and scale */
             add_row(&f, s->tau, s->xy_px[0], s->xy_px[1], (gs_real)w);
+        } else {
+            gs_real tau = s->tau;
+            gs_real ex = (gs_real)s->xy_px[0] - (base.c[0] + tau * (base.c[1] + tau * base.c[2]));
+            gs_real ey = (gs_real)s->xy_px[1] - (base.c[3] + tau * (base.c[4] + tau * base.c[5]));
+            wsums_add(&a, tau, ex, ey, (gs_real)w);
         }
     }
-    return solve_par(&f, out, p);
+    if (!GS_REAL_IS_FLOAT) {
+        wsums_to_fit(&a, &f);
+    }
+    return solve_par(&f, out, p, GS_REAL_IS_FLOAT ? NULL : &base);
 }
 
 /* Index (into the window) of the k-th usable sample; count must cover it. */
