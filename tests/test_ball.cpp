@@ -320,6 +320,27 @@ BallSim tennis(double x_m, double z_m, double t_start)
 
 }  // namespace
 
+// The one-pass motion measure against OpenCV's convert, difference, split and
+// maxima, over widths that leave every SIMD tail and backgrounds at half levels.
+void test_max_channel_diff_matches_opencv(void)
+{
+    cv::RNG rng(7);
+    for (int w = 1; w <= 70; w++) {
+        cv::Mat img(5, w, CV_8UC3), bg(5, w, CV_32FC3);
+        rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+        rng.fill(bg, cv::RNG::UNIFORM, -0.4, 255.4);
+        for (int i = 0; i < bg.rows * w * 3; i += 5) bg.ptr<float>(0)[i] = std::floor(bg.ptr<float>(0)[i]) + 0.5f;
+        cv::Mat got, bg8, diff;
+        gs::max_channel_diff(img, bg, got);
+        bg.convertTo(bg8, CV_8UC3);
+        cv::absdiff(img, bg8, diff);
+        std::vector<cv::Mat> ch;
+        cv::split(diff, ch);
+        cv::Mat want = cv::max(cv::max(ch[0], ch[1]), ch[2]);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(0, cv::countNonZero(got != want), "max_channel_diff differs from OpenCV");
+    }
+}
+
 // ---- rendered clips --------------------------------------------------------------
 
 // One ball, 1080p60, 2.5 m away (D = 40 px): sub-pixel centre and diameter per frame,
@@ -732,6 +753,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_config_keys);
+    RUN_TEST(test_max_channel_diff_matches_opencv);
     RUN_TEST(test_rendered_single_ball_centre_and_diameter);
     RUN_TEST(test_rendered_two_balls_with_distractors);
     RUN_TEST(test_rendered_fixed_colour);

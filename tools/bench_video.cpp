@@ -2,6 +2,7 @@
 // detector -> core) and the share of each stage, on one core by default.
 //
 //   bench_video [FILE] [--fps N] [--frames N] [--codec avc1|mjpg|ffv1] [--hue DEG] [--all-cores]
+//   bench_video --render-only OUT [--frames N] [--codec C]
 //
 // --hue DEG gives the detector the ball's colour ([ball] color = fixed); the
 // rendered clip's ball has hue 30 and is given so by default (the detector's
@@ -12,7 +13,8 @@
 // folder first. By default the process is pinned to one CPU (decoder threads
 // included) and OpenCV runs single-threaded: the figure to compare with real
 // time. Prints frames/s, the real-time factor against the clip's rate, and the
-// time per frame of decode, detection and core.
+// time per frame of decode, detection and core. --render-only writes the clip to
+// OUT and stops, so that runs can time the same clip without its encode.
 #include <sched.h>
 #include <unistd.h>
 
@@ -110,6 +112,7 @@ int main(int argc, char **argv)
     double fps = 0;
     int frames = 600;
     bool all_cores = false;
+    std::string render_only;
     double hue = -2;  // -2: 30 for the rendered clip, learned for a FILE
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
@@ -117,12 +120,20 @@ int main(int argc, char **argv)
         else if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
         else if (a == "--codec" && i + 1 < argc) codec = argv[++i];
         else if (a == "--all-cores") all_cores = true;
+        else if (a == "--render-only" && i + 1 < argc) render_only = argv[++i];
         else if (a == "--hue" && i + 1 < argc) hue = std::atof(argv[++i]);
         else if (a[0] != '-') file = a;
         else {
-            std::fprintf(stderr, "usage: bench_video [FILE] [--fps N] [--frames N] [--codec avc1|mjpg|ffv1] [--hue DEG] [--all-cores]\n");
+            std::fprintf(stderr, "usage: bench_video [FILE] [--fps N] [--frames N] [--codec avc1|mjpg|ffv1] [--hue DEG] [--all-cores] | --render-only OUT\n");
             return 2;
         }
+    }
+    if (!render_only.empty()) {
+        if (!render(render_only, codec, frames)) {
+            std::fprintf(stderr, "bench_video: cannot write %s\n", render_only.c_str());
+            return 1;
+        }
+        return 0;
     }
     std::string dir;
     if (hue == -2) hue = file.empty() ? 30 : -1;

@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -245,6 +246,47 @@ Parabola fit_points(const std::vector<Pt> &pts, size_t last_n)
 }
 
 }  // namespace
+
+// max over the channels of |image - round(background)|: the background rounded
+// to whole grey levels as convertTo would (the threshold is in whole levels), in
+// one pass instead of convert, difference, split and two maxima
+void max_channel_diff(const cv::Mat &img, const cv::Mat &bg, cv::Mat &out)
+{
+    CV_Assert(img.type() == CV_8UC3 && bg.type() == CV_32FC3 && img.size() == bg.size());
+    out.create(img.size(), CV_8U);
+    for (int y = 0; y < img.rows; y++) {
+        const uchar *s = img.ptr<uchar>(y);
+        const float *b = bg.ptr<float>(y);
+        uchar *o = out.ptr<uchar>(y);
+        int x = 0;
+#if CV_SIMD128
+        constexpr int kL = cv::v_uint8x16::nlanes;
+        for (; x + kL <= img.cols; x += kL) {
+            cv::v_uint8x16 s0, s1, s2, b8[3];
+            cv::v_load_deinterleave(s + 3 * x, s0, s1, s2);
+            cv::v_int32x4 q[3][4];
+            for (int k = 0; k < 4; k++) {
+                cv::v_float32x4 f0, f1, f2;
+                cv::v_load_deinterleave(b + 3 * (x + 4 * k), f0, f1, f2);
+                q[0][k] = cv::v_round(f0);
+                q[1][k] = cv::v_round(f1);
+                q[2][k] = cv::v_round(f2);
+            }
+            for (int c = 0; c < 3; c++)
+                b8[c] = cv::v_pack_u(cv::v_pack(q[c][0], q[c][1]), cv::v_pack(q[c][2], q[c][3]));
+            cv::v_uint8x16 m = cv::v_max(cv::v_max(cv::v_absdiff(s0, b8[0]), cv::v_absdiff(s1, b8[1])),
+                                         cv::v_absdiff(s2, b8[2]));
+            cv::v_store(o + x, m);
+        }
+#endif
+        for (; x < img.cols; x++) {
+            int m = 0;
+            for (int c = 0; c < 3; c++)
+                m = std::max(m, std::abs((int)s[3 * x + c] - (int)cv::saturate_cast<uchar>(b[3 * x + c])));
+            o[x] = (uchar)m;
+        }
+    }
+}
 
 struct BallDetector::Impl {
     BallConfig cfg;
@@ -854,12 +896,8 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         return;
     }
     // motion: difference to the background, any channel (brighter, darker, any hue)
-    cv::Mat bg8, diff;  // in 8 bits: the threshold is whole grey levels anyway, and it is ~4x cheaper
-    bg_small.convertTo(bg8, CV_8UC3);
-    cv::absdiff(small, bg8, diff);
-    std::vector<cv::Mat> ch;
-    cv::split(diff, ch);
-    cv::Mat mx = cv::max(cv::max(ch[0], ch[1]), ch[2]);
+    cv::Mat mx;
+    max_channel_diff(small, bg_small, mx);
     // the threshold: motion_min, or well above the frame's typical difference when
     // compression noise, flicker or a fade lift it (4 robust sigmas of it)
     double thr = cfg.motion_min;
@@ -886,27 +924,39 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     }
     std::vector<Blob> blobs;
     if (hue_set) {
-        cv::cvtColor(small, hsv, cv::COLOR_BGR2HSV);
-        double h = hue / 2.0, tol = hue_tol / 2.0;
-        int smin = (int)std::lround(sat_min * 255.0), vmin = (int)std::lround(val_min * 255.0);
-        cv::Mat cm;
-        double lo = h - tol, hi = h + tol;
-        if (lo < 0) {
-            cv::Mat a, b;
-            cv::inRange(hsv, cv::Scalar(0, smin, vmin), cv::Scalar(hi, 255, 255), a);
-            cv::inRange(hsv, cv::Scalar(lo + 180.0, smin, vmin), cv::Scalar(180, 255, 255), b);
-            cm = a | b;
-        } else if (hi > 180) {
-            cv::Mat a, b;
-            cv::inRange(hsv, cv::Scalar(lo, smin, vmin), cv::Scalar(180, 255, 255), a);
-            cv::inRange(hsv, cv::Scalar(0, smin, vmin), cv::Scalar(hi - 180.0, 255, 255), b);
-            cm = a | b;
-        } else {
-            cv::inRange(hsv, cv::Scalar(lo, smin, vmin), cv::Scalar(hi, 255, 255), cm);
-        }
         cv::Mat md;
         cv::dilate(motion, md, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
-        cand = cm & md;
+        double h = hue / 2.0, tol = hue_tol / 2.0;
+        int smin = (int)std::lround(sat_min * 255.0), vmin = (int)std::lround(val_min * 255.0);
+        double lo = h - tol, hi = h + tol;
+        // the colour only matters where something moves: HSV per band of rows, over
+        // the columns that move in it (the moving share of a frame is small)
+        cand.create(small.size(), CV_8U);
+        cand.setTo(0);
+        constexpr int kBand = 16;
+        for (int y0 = 0; y0 < small.rows; y0 += kBand) {
+            cv::Rect band(0, y0, small.cols, std::min(kBand, small.rows - y0));
+            cv::Rect r = cv::boundingRect(md(band));
+            if (r.area() <= 0) continue;
+            r.y += y0;
+            cv::cvtColor(small(r), hsv, cv::COLOR_BGR2HSV);
+            cv::Mat cm;
+            if (lo < 0) {
+                cv::Mat a, b;
+                cv::inRange(hsv, cv::Scalar(0, smin, vmin), cv::Scalar(hi, 255, 255), a);
+                cv::inRange(hsv, cv::Scalar(lo + 180.0, smin, vmin), cv::Scalar(180, 255, 255), b);
+                cm = a | b;
+            } else if (hi > 180) {
+                cv::Mat a, b;
+                cv::inRange(hsv, cv::Scalar(lo, smin, vmin), cv::Scalar(180, 255, 255), a);
+                cv::inRange(hsv, cv::Scalar(0, smin, vmin), cv::Scalar(hi - 180.0, 255, 255), b);
+                cm = a | b;
+            } else {
+                cv::inRange(hsv, cv::Scalar(lo, smin, vmin), cv::Scalar(hi, 255, 255), cm);
+            }
+            cv::Mat dst = cand(r);
+            cv::bitwise_and(cm, md(r), dst);
+        }
     } else {
         cand = motion;
     }

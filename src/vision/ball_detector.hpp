@@ -91,6 +91,10 @@ private:
     std::unique_ptr<Impl> p_;
 };
 
+// The detector's motion measure: per pixel the largest over the three channels of
+// |img - background rounded to whole levels| (img CV_8UC3, bg CV_32FC3 of its size).
+void max_channel_diff(const cv::Mat &img, const cv::Mat &bg, cv::Mat &out);
+
 }  // namespace gs
 
 #endif
