@@ -1194,7 +1194,21 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         saved_f.push_back(bg_full(keep_f.back()).clone());
     }
     cv::accumulateWeighted(small, bg_small, rate);
-    cv::accumulateWeighted(bgr, bg_full, rate);
+    // the full-resolution background serves only the mattes at the balls: each band
+    // of rows learns at 20 Hz or more with the rate of the frames it skips, not at
+    // every frame of a fast camera (its memory traffic is the detector's largest)
+    int every = frame < 16 ? 1 : std::max(1, (int)std::floor(1.0 / (20.0 * std::max(1e-4, dt))));
+    if (every == 1) {
+        cv::accumulateWeighted(bgr, bg_full, rate);
+    } else {
+        double rate_k = 1.0 - std::pow(1.0 - rate, every);
+        constexpr int kBandRows = 8;
+        for (int y0 = kBandRows * (int)(frame % every); y0 < bgr.rows; y0 += kBandRows * every) {
+            cv::Range rows(y0, std::min(bgr.rows, y0 + kBandRows));
+            cv::Mat dst = bg_full.rowRange(rows);
+            cv::accumulateWeighted(bgr.rowRange(rows), dst, rate_k);
+        }
+    }
     for (size_t i = keep_s.size(); i-- > 0;) {
         saved_s[i].copyTo(bg_small(keep_s[i]));
         saved_f[i].copyTo(bg_full(keep_f[i]));
