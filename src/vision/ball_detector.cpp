@@ -260,23 +260,20 @@ void max_channel_diff(const cv::Mat &img, const cv::Mat &bg, cv::Mat &out)
         uchar *o = out.ptr<uchar>(y);
         int x = 0;
 #if CV_SIMD128
-        constexpr int kL = cv::v_uint8x16::nlanes;
-        for (; x + kL <= img.cols; x += kL) {
-            cv::v_uint8x16 s0, s1, s2, b8[3];
-            cv::v_load_deinterleave(s + 3 * x, s0, s1, s2);
-            cv::v_int32x4 q[3][4];
-            for (int k = 0; k < 4; k++) {
-                cv::v_float32x4 f0, f1, f2;
-                cv::v_load_deinterleave(b + 3 * (x + 4 * k), f0, f1, f2);
-                q[0][k] = cv::v_round(f0);
-                q[1][k] = cv::v_round(f1);
-                q[2][k] = cv::v_round(f2);
+        // 16 pixels at a time: the 48 values rounded and differenced as they lie,
+        // then deinterleaved once as bytes for the maximum
+        alignas(16) uchar d48[48];
+        for (; x + 16 <= img.cols; x += 16) {
+            const float *bp = b + 3 * x;
+            for (int k = 0; k < 3; k++) {
+                cv::v_int32x4 q0 = cv::v_round(cv::v_load(bp + 16 * k)), q1 = cv::v_round(cv::v_load(bp + 16 * k + 4));
+                cv::v_int32x4 q2 = cv::v_round(cv::v_load(bp + 16 * k + 8)), q3 = cv::v_round(cv::v_load(bp + 16 * k + 12));
+                cv::v_uint8x16 b8 = cv::v_pack_u(cv::v_pack(q0, q1), cv::v_pack(q2, q3));
+                cv::v_store_aligned(d48 + 16 * k, cv::v_absdiff(cv::v_load(s + 3 * x + 16 * k), b8));
             }
-            for (int c = 0; c < 3; c++)
-                b8[c] = cv::v_pack_u(cv::v_pack(q[c][0], q[c][1]), cv::v_pack(q[c][2], q[c][3]));
-            cv::v_uint8x16 m = cv::v_max(cv::v_max(cv::v_absdiff(s0, b8[0]), cv::v_absdiff(s1, b8[1])),
-                                         cv::v_absdiff(s2, b8[2]));
-            cv::v_store(o + x, m);
+            cv::v_uint8x16 d0, d1, d2;
+            cv::v_load_deinterleave(d48, d0, d1, d2);
+            cv::v_store(o + x, cv::v_max(cv::v_max(d0, d1), d2));
         }
 #endif
         for (; x < img.cols; x++) {
@@ -924,21 +921,30 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     }
     std::vector<Blob> blobs;
     if (hue_set) {
+        const cv::Mat kern = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5));
+        constexpr int kReach = 2;  // the kernel's radius
         cv::Mat md;
-        cv::dilate(motion, md, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
         double h = hue / 2.0, tol = hue_tol / 2.0;
         int smin = (int)std::lround(sat_min * 255.0), vmin = (int)std::lround(val_min * 255.0);
         double lo = h - tol, hi = h + tol;
-        // the colour only matters where something moves: HSV per band of rows, over
-        // the columns that move in it (the moving share of a frame is small)
+        // the colour only matters near motion: per band of rows, the motion dilated
+        // and HSV over the columns within the kernel's reach of it (the moving share
+        // of a frame is small)
         cand.create(small.size(), CV_8U);
         cand.setTo(0);
         constexpr int kBand = 16;
         for (int y0 = 0; y0 < small.rows; y0 += kBand) {
-            cv::Rect band(0, y0, small.cols, std::min(kBand, small.rows - y0));
-            cv::Rect r = cv::boundingRect(md(band));
-            if (r.area() <= 0) continue;
-            r.y += y0;
+            const int y1 = std::min(small.rows, y0 + kBand);
+            const int ya = std::max(0, y0 - kReach), yb = std::min(small.rows, y1 + kReach);
+            cv::Rect mr = cv::boundingRect(motion(cv::Range(ya, yb), cv::Range::all()));
+            if (mr.area() <= 0) continue;
+            const int xa = std::max(0, mr.x - kReach), xb = std::min(small.cols, mr.x + mr.width + kReach);
+            // the dilation's input: those columns and rows with the kernel's reach around them
+            const int xi = std::max(0, xa - kReach), xj = std::min(small.cols, xb + kReach);
+            cv::Mat md_ext;
+            cv::dilate(motion(cv::Range(ya, yb), cv::Range(xi, xj)), md_ext, kern);
+            md = md_ext(cv::Range(y0 - ya, y1 - ya), cv::Range(xa - xi, xb - xi));
+            cv::Rect r(xa, y0, xb - xa, y1 - y0);
             cv::cvtColor(small(r), hsv, cv::COLOR_BGR2HSV);
             cv::Mat cm;
             if (lo < 0) {
@@ -955,7 +961,7 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
                 cv::inRange(hsv, cv::Scalar(lo, smin, vmin), cv::Scalar(hi, 255, 255), cm);
             }
             cv::Mat dst = cand(r);
-            cv::bitwise_and(cm, md(r), dst);
+            cv::bitwise_and(cm, md, dst);
         }
     } else {
         cand = motion;
