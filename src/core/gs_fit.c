@@ -374,30 +374,38 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
 }
 
 /* The k-th smallest of n float bit patterns (non-negative floats order like their
- * bits): a radix selection, 4 bits a pass, each pass keeping only the keys that
- * share the digits chosen so far (key is overwritten). The same float as sorting. */
+ * bits; key is reordered): Wirth's selection, partitions about the k-th slot until
+ * it holds the key a sort would put there. The same float as sorting. */
 static float select_key(uint32_t *key, uint32_t n, uint32_t k)
 {
-    int shift;
+    int32_t l = 0, r = (int32_t)n - 1, kk = (int32_t)k; /* n <= GS_FIT_CACHE */
     float v;
-    for (shift = 28; shift >= 0 && n > 1u; shift -= 4) {
-        uint32_t cnt[16] = {0};
-        uint32_t d = 0, i, j = 0;
-        for (i = 0; i < n; i++) {
-            cnt[(key[i] >> (uint32_t)shift) & 15u]++;
-        }
-        while (d < 15u && k >= cnt[d]) {
-            k -= cnt[d];
-            d++;
-        }
-        for (i = 0; i < n; i++) {
-            if (((key[i] >> (uint32_t)shift) & 15u) == d) {
-                key[j++] = key[i];
+    while (l < r) {
+        uint32_t x = key[kk];
+        int32_t i = l, j = r;
+        do {
+            while (key[i] < x) {
+                i++;
             }
+            while (x < key[j]) {
+                j--;
+            }
+            if (i <= j) {
+                uint32_t t = key[i];
+                key[i] = key[j];
+                key[j] = t;
+                i++;
+                j--;
+            }
+        } while (i <= j);
+        if (j < kk) {
+            l = i;
         }
-        n = j;
+        if (kk < i) {
+            r = j;
+        }
     }
-    memcpy(&v, &key[0], sizeof v);
+    memcpy(&v, &key[kk], sizeof v);
     return v;
 }
 
@@ -566,6 +574,66 @@ static void wsums_to_fit(const gs_wsums *a, gs_fit *f)
     f->n = a->n;
 }
 
+#if GS_FIT_FAST
+/* wsums_add over a window the cache holds, in double: the same products summed in the
+ * same order, in registers, and the kept bits set a word at a time. */
+static void wsums_cached(const gs_win *wn, const gs_par *model, const gs_par *base, w_mode mode, gs_real cut,
+                         uint32_t *keep, const gs_real *r2, gs_wsums *a)
+{
+    gs_real g0 = GS_R(0.0), g1 = GS_R(0.0), g2 = GS_R(0.0), g3 = GS_R(0.0), g4 = GS_R(0.0);
+    gs_real bx0 = g0, bx1 = g0, bx2 = g0, by0 = g0, by1 = g0, by2 = g0, eex = g0, eey = g0;
+    uint32_t n = 0, word = 0, i;
+    for (i = 0; i < wn->count; i++) {
+        const gs_fsamp *s = &wn->cache[i];
+        float w = s->w > 0.0f ? sample_weight(s, model, mode, cut, r2 ? &r2[i] : NULL) : 0.0f;
+        if (w > 0.0f) {
+            gs_real tau = s->tau, wr = (gs_real)w, wt;
+            gs_real ex = (gs_real)s->xy_px[0] - (base->c[0] + tau * (base->c[1] + tau * base->c[2]));
+            gs_real ey = (gs_real)s->xy_px[1] - (base->c[3] + tau * (base->c[4] + tau * base->c[5]));
+            word |= 1u << (i & 31u);
+            eex += wr * ex * ex;
+            eey += wr * ey * ey;
+            g0 += wr;
+            bx0 += wr * ex;
+            by0 += wr * ey;
+            wt = wr * tau;
+            g1 += wt;
+            bx1 += wt * ex;
+            by1 += wt * ey;
+            wt *= tau;
+            g2 += wt;
+            bx2 += wt * ex;
+            by2 += wt * ey;
+            wt *= tau;
+            g3 += wt;
+            wt *= tau;
+            g4 += wt;
+            n++;
+        }
+        if ((i & 31u) == 31u || i + 1u == wn->count) {
+            /* bits past count keep their values, as keep_set leaves them */
+            uint32_t mask = (i & 31u) == 31u ? ~0u : (1u << ((i & 31u) + 1u)) - 1u;
+            keep[i >> 5] = (keep[i >> 5] & ~mask) | word;
+            word = 0;
+        }
+    }
+    a->g[0] = g0;
+    a->g[1] = g1;
+    a->g[2] = g2;
+    a->g[3] = g3;
+    a->g[4] = g4;
+    a->b[0][0] = bx0;
+    a->b[0][1] = bx1;
+    a->b[0][2] = bx2;
+    a->b[1][0] = by0;
+    a->b[1][1] = by1;
+    a->b[1][2] = by2;
+    a->ee[0] = eex;
+    a->ee[1] = eey;
+    a->n = n;
+}
+#endif
+
 /* Weighted LS over the window; flags each sample with a positive weight in keep, the
  * tau-basis parabola to p. r2: the samples' squared residuals from model, or NULL.
  * In double the normal equations (sums about model, when there is one) lose nothing
@@ -584,6 +652,13 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
         base = *model;
     }
     fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
+#if GS_FIT_FAST
+    if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE) {
+        wsums_cached(wn, model, &base, mode, cut, keep, r2, &a);
+        wsums_to_fit(&a, &f);
+        return solve_par(&f, out, p, &base);
+    }
+#endif
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
