@@ -194,10 +194,37 @@ static void trace_fit(const gs_flight *f, const char *purpose, int64_t t0_us, in
     emit(f, &ev);
 }
 
-/* small sorts for medians of bounded arrays */
+/* Medians of bounded arrays of finite values (v is reordered). Where the build
+ * optimises for speed, the middle one by Wirth's selection (afterwards nothing before
+ * it is larger, nothing after it smaller; for even n the lower middle is the largest
+ * before it); where it optimises for size, an insertion sort. The same values. */
 static gs_real median_f(float *v, uint32_t n)
 {
     if (n == 0) return NAN;
+#ifndef __OPTIMIZE_SIZE__
+    int32_t l = 0, r = (int32_t)n - 1, k = (int32_t)(n / 2);
+    while (l < r) {
+        float x = v[k];
+        int32_t i = l, j = r;
+        do {
+            while (v[i] < x) i++;
+            while (x < v[j]) j--;
+            if (i <= j) {
+                float t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+                i++;
+                j--;
+            }
+        } while (i <= j);
+        if (j < k) l = i;
+        if (k < i) r = j;
+    }
+    if (n & 1u) return (gs_real)v[k];
+    float lo = v[0];
+    for (int32_t i = 1; i < k; i++) lo = v[i] > lo ? v[i] : lo;
+    return GS_R(0.5) * ((gs_real)lo + (gs_real)v[k]);
+#endif
     for (uint32_t i = 1; i < n; i++) {
         float x = v[i];
         uint32_t j = i;
