@@ -268,6 +268,7 @@ typedef struct {
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
     uint32_t *key;            /* the median's selection scratch */
+    float *med_key;           /* fast builds: the last median's squared residual, as a float */
 } gs_win;
 
 static uint32_t xorshift32(uint32_t *state)
@@ -423,6 +424,28 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
     if (left == 0) {
         return (gs_real)NAN;
     }
+#if GS_FIT_FAST
+    if (wn->count <= GS_FIT_CACHE) {
+        /* every usable sample cached: one pass collects all keys (no prefix yet) */
+        const gs_fsamp *c = wn->cache;
+        gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
+        uint32_t n = 0;
+        for (i = 0; i < wn->count; i++) {
+            if (c[i].w > 0.0f) {
+                gs_real tau = c[i].tau;
+                gs_real ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
+                gs_real ey = (gs_real)c[i].xy_px[1] - (c3 + tau * (c4 + tau * c5));
+                gs_real r2 = ex * ex + ey * ey;
+                float f = (float)r2;
+                wn->r2[i] = r2;
+                memcpy(&wn->key[n++], &f, sizeof f);
+            }
+        }
+        v = select_key(wn->key, n, (n - 1) / 2);
+        *wn->med_key = v;
+        return sqrt((gs_real)v);
+    }
+#endif
     k = (left - 1) / 2; /* lower median: exact for odd m, robust enough for even m */
     while (mask != ~0u) {
         uint32_t cnt[16] = {0};
@@ -486,6 +509,35 @@ static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
     }
     return false;
 }
+
+#if GS_FIT_FAST
+/* median_below over a window the cache holds, in double: sqrt((double)a) < sqrt((double)b)
+ * exactly when a < b for floats a, b >= 0 (adjacent floats differ by far more than a
+ * double's rounding), so the squared residuals' floats are compared with the median's. */
+static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key)
+{
+    const gs_fsamp *c = wn->cache;
+    gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
+    uint32_t need = (wn->m - 1) / 2 + 1, room = wn->m - need, i;
+    for (i = 0; i < wn->count; i++) {
+        gs_real tau, ex, ey;
+        if (!(c[i].w > 0.0f)) {
+            continue;
+        }
+        tau = c[i].tau;
+        ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
+        ey = (gs_real)c[i].xy_px[1] - (c3 + tau * (c4 + tau * c5));
+        if ((float)(ex * ex + ey * ey) < med_key) {
+            if (--need == 0u) {
+                return true;
+            }
+        } else if (room-- == 0u) {
+            return false;
+        }
+    }
+    return false;
+}
+#endif
 
 /* Tukey biweight of a residual norm r with cut-off cut. */
 static gs_real tukey(gs_real r, gs_real cut)
@@ -585,7 +637,22 @@ static void wsums_cached(const gs_win *wn, const gs_par *model, const gs_par *ba
     uint32_t n = 0, word = 0, i;
     for (i = 0; i < wn->count; i++) {
         const gs_fsamp *s = &wn->cache[i];
-        float w = s->w > 0.0f ? sample_weight(s, model, mode, cut, r2 ? &r2[i] : NULL) : 0.0f;
+        float w = s->w;
+        if (!(w > 0.0f)) {
+            w = 0.0f;
+        } else if (mode == W_TUKEY && r2) {
+            /* sample_weight's Tukey weight from the residual the median kept */
+            gs_real r = sqrt(r2[i]), u;
+            if (!(r < cut)) {
+                w = 0.0f;
+            } else {
+                u = r / cut;
+                u = GS_R(1.0) - u * u;
+                w = (float)((gs_real)s->w * (u * u));
+            }
+        } else if (mode != W_PRIOR) {
+            w = sample_weight(s, model, mode, cut, r2 ? &r2[i] : NULL);
+        }
         if (w > 0.0f) {
             gs_real tau = s->tau, wr = (gs_real)w, wt;
             gs_real ex = (gs_real)s->xy_px[0] - (base->c[0] + tau * (base->c[1] + tau * base->c[2]));
@@ -720,6 +787,9 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     uint32_t state = GS_FIT_SEED_IRLS;
     uint32_t third = m / 3, k;
     bool found = false;
+#if GS_FIT_FAST
+    float best_key = 0.0f; /* *best_med's squared residual as a float, once found */
+#endif
     *best_med = (gs_real)INFINITY;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
         uint32_t ka = rand_below(&state, third);
@@ -730,14 +800,20 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
-        if (GS_FIT_FAST && found && !median_below(wn, &p, *best_med)) {
+#if GS_FIT_FAST
+        if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_key)
+                                                                       : !median_below(wn, &p, *best_med))) {
             continue; /* cannot win: no median needed (m > 3 here: m = 3 stops at the first) */
         }
+#endif
         med = median_resid(wn, &p);
         if (med < *best_med) {
             *best_med = med;
             *best = p;
             found = true;
+#if GS_FIT_FAST
+            best_key = *wn->med_key;
+#endif
         }
         if (m == 3) {
             break;
@@ -974,12 +1050,18 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     gs_fsamp cache[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
     gs_real r2[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
     uint32_t key[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
+#if GS_FIT_FAST
+    float med_key = 0.0f;
+#endif
     gs_win wn;
     uint32_t i;
     gs_status st;
     wn.cache = cache;
     wn.r2 = r2;
     wn.key = key;
+#if GS_FIT_FAST
+    wn.med_key = &med_key;
+#endif
     if (!out) {
         return GS_EINVAL;
     }
