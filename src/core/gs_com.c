@@ -7,8 +7,13 @@
 
 #include "gravscale/gs_com.h"
 
-/* one copy of a helper called from several places: smaller code on the Cortex-M4 */
+/* one copy of a helper called from several places: smaller code on the Cortex-M4 (where
+ * the build optimises for size); elsewhere the compiler inlines what pays */
+#ifdef __OPTIMIZE_SIZE__
 #define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
 
 #define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
 
@@ -243,6 +248,33 @@ static bool is_rebuilt(const frame *f, int a, int b)
 static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
 {
     f->obs = 0;
+#ifndef __OPTIMIZE_SIZE__
+    if (GS_WITH_COCO17 && !blaze) {
+        /* the same as the loop below, without its per-keypoint layout choice */
+        uint32_t obs = 0;
+        for (int k = 0; k < 17; k++) {
+            const gs_kp *q = &kp[k];
+            if (kp_usable(q, min_conf)) {
+                obs |= BIT(k);
+                f->c[k] = conf01(q->c);
+                f->p[k] = (vec2){ q->x_px, q->y_px };
+            } else {
+                f->c[k] = 0.0f;
+                f->p[k] = (vec2){ NAN, NAN };
+            }
+        }
+        for (int k = 17; k < K_N; k++) {
+            f->c[k] = 0.0f;
+            f->p[k] = (vec2){ NAN, NAN };
+        }
+        f->obs = obs;
+        f->have = obs;
+        f->blaze = blaze;
+        f->used = 0;
+        f->com = (wsum){ 0.0f, 0.0f, 0.0f, 0.0f };
+        return;
+    }
+#endif
     for (int k = 0; k < K_N; k++) {
         f->c[k] = 0.0f;
         f->p[k] = (vec2){ NAN, NAN };
@@ -582,12 +614,19 @@ static void com_result(const frame *f, float total, gs_com_out *out)
     vec2 com = wsum_mean(&f->com);
     float csum = 0.0f;
     int n = 0;
+#ifndef __OPTIMIZE_SIZE__
+    for (uint32_t u = f->used; u != 0u; u &= u - 1u) { /* the set bits in ascending order, as below */
+        csum += f->c[__builtin_ctz(u)];
+        n++;
+    }
+#else
     for (int k = 0; k < K_N; k++) {
         if (f->used & BIT(k)) {
             csum += f->c[k];
             n++;
         }
     }
+#endif
     float frac = f->com.e / total;
     float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
     /* a segment missing outright (not even rebuilt from its mirror, e.g. the head
