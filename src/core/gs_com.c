@@ -210,6 +210,7 @@ static float kp_dist(const frame *f, int a, int b)
     return v_len(kp_diff(f, a, b));
 }
 
+#ifdef __OPTIMIZE_SIZE__
 /* Angle at keypoint b between b->a and b->c in degrees, NaN when a leg has no length. */
 static float angle_deg(const frame *f, int a, int b, int c)
 {
@@ -220,6 +221,40 @@ static float angle_deg(const frame *f, int a, int b, int c)
     }
     return acos_deg(v_dot(u, v) / (lu * lv));
 }
+#else
+/* The cosine of angle_deg's angle, NaN when a leg has no length. */
+static float angle_cos(const frame *f, int a, int b, int c)
+{
+    vec2 u = kp_diff(f, a, b), v = kp_diff(f, c, b);
+    float lu = v_len(u), lv = v_len(v);
+    if (!(lu > 0.0f) || !(lv > 0.0f)) {
+        return NAN;
+    }
+    return v_dot(u, v) / (lu * lv);
+}
+
+/* ramp(acos_deg(cs), x0, x1) with c0, c1 the cosines of x0, x1 degrees: where the cosine
+ * lies clearly beyond either end the ramp is exactly 0 or 1 and no acos is needed (acos
+ * falls as the cosine rises; 1e-4 in the cosine is at least 0.005 degree there, far beyond
+ * the rounding of acosf and of the constants). */
+static float ramp_acos(float cs, float x0, float x1, float c0, float c1)
+{
+    float s = x0 < x1 ? 1.0f : -1.0f;
+    if (s * (cs - c0) > 1e-4f) {
+        return 0.0f;
+    }
+    if (s * (c1 - cs) > 1e-4f) {
+        return 1.0f;
+    }
+    return ramp(acos_deg(cs), x0, x1);
+}
+#define COS_KNEE_0 -0.8660254f /* cos 150 deg */
+#define COS_KNEE_1 -0.9848078f /* cos 170 deg */
+#define COS_HIP_0 -0.7660444f  /* cos 140 deg */
+#define COS_HIP_1 -0.9659258f  /* cos 165 deg */
+#define COS_TILT_0 0.8191520f  /* cos 35 deg */
+#define COS_TILT_1 0.9848078f  /* cos 10 deg */
+#endif
 
 /* The same keypoint on the other side of the body (left odd, right even). */
 static int other_side(int k)
@@ -527,10 +562,17 @@ static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axi
         if (!all_in(f->obs >> i, BIT(K_LHIP) | BIT(K_LKNE) | BIT(K_LANK))) {
             continue;
         }
+#ifndef __OPTIMIZE_SIZE__
+        knee = min_nan(knee, ramp_acos(angle_cos(f, hp, kn, an), KNEE_DEG_0, KNEE_DEG_1, COS_KNEE_0, COS_KNEE_1));
+        if ((f->obs >> i) & BIT(K_LSHO)) {
+            other = min_nan(other, ramp_acos(angle_cos(f, sh, hp, kn), HIP_DEG_0, HIP_DEG_1, COS_HIP_0, COS_HIP_1));
+        }
+#else
         knee = min_nan(knee, ramp(angle_deg(f, hp, kn, an), KNEE_DEG_0, KNEE_DEG_1));
         if ((f->obs >> i) & BIT(K_LSHO)) {
             other = min_nan(other, ramp(angle_deg(f, sh, hp, kn), HIP_DEG_0, HIP_DEG_1));
         }
+#endif
         if (trunk_len > 0.0f) {
             float leg = kp_dist(f, hp, kn) + kp_dist(f, kn, an);
             other = min_nan(other, ramp(leg / trunk_len, LEG_TRUNK_0, LEG_TRUNK_1));
@@ -540,8 +582,13 @@ static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axi
         return NAN; /* legs missing: cannot tell */
     }
     if (axis_from_body && trunk_len > 0.0f) {
+#ifndef __OPTIMIZE_SIZE__
+        other = min_nan(other, ramp_acos(v_dot(trunk, up) / trunk_len, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1, COS_TILT_0,
+                                         COS_TILT_1));
+#else
         float tilt_deg = acos_deg(v_dot(trunk, up) / trunk_len);
         other = min_nan(other, ramp(tilt_deg, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1));
+#endif
     }
     return min_nan(knee, other);
 }
