@@ -24,6 +24,14 @@
 #define GS_FIT_FAST 1
 #endif
 
+/* Hosts: GCC's straight-line vectoriser pairs a sample's sums and shuffles them for
+ * every sample (more instructions, not fewer) */
+#if GS_FIT_FAST && defined(__GNUC__) && !defined(__clang__)
+#define GS_NO_SLP __attribute__((optimize("no-tree-slp-vectorize")))
+#else
+#define GS_NO_SLP
+#endif
+
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
 #define GS_FIT_TUKEY_C GS_R(4.685)
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
@@ -629,7 +637,7 @@ static void wsums_to_fit(const gs_wsums *a, gs_fit *f)
 #if GS_FIT_FAST
 /* wsums_add over a window the cache holds, in double: the same products summed in the
  * same order, in registers, and the kept bits set a word at a time. */
-static void wsums_cached(const gs_win *wn, const gs_par *model, const gs_par *base, w_mode mode, gs_real cut,
+GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const gs_par *base, w_mode mode, gs_real cut,
                          uint32_t *keep, const gs_real *r2, gs_wsums *a)
 {
     gs_real g0 = GS_R(0.0), g1 = GS_R(0.0), g2 = GS_R(0.0), g3 = GS_R(0.0), g4 = GS_R(0.0);
