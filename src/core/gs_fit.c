@@ -277,6 +277,7 @@ typedef struct {
     gs_real *r2;              /* their squared residuals from the last median_resid */
     uint32_t *key;            /* the median's selection scratch */
     float *med_key;           /* fast builds: the last median's squared residual, as a float */
+    gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y (3 rows of m) */
 } gs_win;
 
 static uint32_t xorshift32(uint32_t *state)
@@ -519,27 +520,74 @@ static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
 }
 
 #if GS_FIT_FAST
+#if defined(__GNUC__)
+typedef double gs_v2d __attribute__((vector_size(16)));
+#endif
+
+/* The double T with r < T exactly when (float)r < key, for r >= 0 and key a float
+ * >= 0: (float)r falls below key when r lies below the midpoint of key and the float
+ * before it, or on it when that float is even (ties round to even). Both floats and
+ * their midpoint are exact in double. */
+static double below_key(float key)
+{
+    uint32_t kb;
+    uint64_t mb;
+    float lo;
+    double mid;
+    memcpy(&kb, &key, sizeof kb);
+    if (kb == 0u) {
+        return 0.0; /* nothing rounds below +0 */
+    }
+    kb--;
+    memcpy(&lo, &kb, sizeof lo);
+    mid = ((double)lo + (double)key) * 0.5;
+    if ((kb & 1u) == 0u) {
+        memcpy(&mb, &mid, sizeof mb);
+        mb++; /* the next double up: r < it when r <= mid */
+        memcpy(&mid, &mb, sizeof mid);
+    }
+    return mid;
+}
+
 /* median_below over a window the cache holds, in double: sqrt((double)a) < sqrt((double)b)
  * exactly when a < b for floats a, b >= 0 (adjacent floats differ by far more than a
- * double's rounding), so the squared residuals' floats are compared with the median's. */
+ * double's rounding), so each squared residual's float is compared with the median's
+ * (through below_key, without the conversion). The usable samples in rows, two at a time
+ * where the compiler has vectors; the decision only counts, in any order. */
 static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key)
 {
-    const gs_fsamp *c = wn->cache;
+    const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
     gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
-    uint32_t need = (wn->m - 1) / 2 + 1, room = wn->m - need, i;
-    for (i = 0; i < wn->count; i++) {
-        gs_real tau, ex, ey;
-        if (!(c[i].w > 0.0f)) {
-            continue;
+    double T = below_key(med_key);
+    uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
+#if defined(__GNUC__)
+    gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5};
+    for (; j + 1u < m; j += 2u) {
+        gs_v2d tau, vx, vy, ex, ey, r2;
+        memcpy(&tau, &t[j], sizeof tau);
+        memcpy(&vx, &x[j], sizeof vx);
+        memcpy(&vy, &y[j], sizeof vy);
+        ex = vx - (v0 + tau * (v1 + tau * v2));
+        ey = vy - (v3 + tau * (v4 + tau * v5));
+        r2 = ex * ex + ey * ey;
+        less += (uint32_t)(r2[0] < T) + (uint32_t)(r2[1] < T);
+        if (less >= need) {
+            return true;
         }
-        tau = c[i].tau;
-        ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
-        ey = (gs_real)c[i].xy_px[1] - (c3 + tau * (c4 + tau * c5));
-        if ((float)(ex * ex + ey * ey) < med_key) {
-            if (--need == 0u) {
-                return true;
-            }
-        } else if (room-- == 0u) {
+        if (j + 2u - less > room) {
+            return false;
+        }
+    }
+#endif
+    for (; j < m; j++) {
+        gs_real tau = t[j];
+        gs_real ex = x[j] - (c0 + tau * (c1 + tau * c2));
+        gs_real ey = y[j] - (c3 + tau * (c4 + tau * c5));
+        less += (uint32_t)(ex * ex + ey * ey < T);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 1u - less > room) {
             return false;
         }
     }
@@ -1034,6 +1082,19 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
             wn->cache[i].w = 0.0f;
         }
     }
+#if GS_FIT_FAST
+    if (!GS_REAL_IS_FLOAT && count <= GS_FIT_CACHE) {
+        uint32_t n = 0;
+        for (i = 0; i < count; i++) {
+            if (wn->cache[i].w > 0.0f) {
+                wn->soa[n] = wn->cache[i].tau;
+                wn->soa[GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[0];
+                wn->soa[2u * GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[1];
+                n++;
+            }
+        }
+    }
+#endif
     return GS_OK;
 }
 
@@ -1060,6 +1121,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     uint32_t key[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
 #if GS_FIT_FAST
     float med_key = 0.0f;
+    gs_real soa[GS_REAL_IS_FLOAT ? 1u : 3u * GS_FIT_CACHE];
 #endif
     gs_win wn;
     uint32_t i;
@@ -1069,6 +1131,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     wn.key = key;
 #if GS_FIT_FAST
     wn.med_key = &med_key;
+    wn.soa = soa;
 #endif
     if (!out) {
         return GS_EINVAL;
