@@ -32,6 +32,11 @@
 #define GS_NO_SLP
 #endif
 
+#if GS_FIT_FAST && defined(__GNUC__)
+/* two doubles, for the hot loops over a cached window (element-wise IEEE, as scalars) */
+typedef double gs_v2d __attribute__((vector_size(16)));
+#endif
+
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
 #define GS_FIT_TUKEY_C GS_R(4.685)
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
@@ -439,7 +444,30 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
         const gs_fsamp *c = wn->cache;
         gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
         uint32_t n = 0;
-        for (i = 0; i < wn->count; i++) {
+#if defined(__GNUC__)
+        if (!GS_REAL_IS_FLOAT && wn->m == wn->count) {
+            /* every sample usable: the rows of median_below_cached, two at a time */
+            const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
+            gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5};
+            for (i = 0; i + 1u < wn->count; i += 2u) {
+                gs_v2d tau, vx, vy, ex, ey, r2;
+                float f0, f1;
+                memcpy(&tau, &t[i], sizeof tau);
+                memcpy(&vx, &x[i], sizeof vx);
+                memcpy(&vy, &y[i], sizeof vy);
+                ex = vx - (v0 + tau * (v1 + tau * v2));
+                ey = vy - (v3 + tau * (v4 + tau * v5));
+                r2 = ex * ex + ey * ey;
+                memcpy(&wn->r2[i], &r2, sizeof r2);
+                f0 = (float)r2[0];
+                f1 = (float)r2[1];
+                memcpy(&wn->key[i], &f0, sizeof f0);
+                memcpy(&wn->key[i + 1u], &f1, sizeof f1);
+            }
+            n = i;
+        }
+#endif
+        for (i = n; i < wn->count; i++) {
             if (c[i].w > 0.0f) {
                 gs_real tau = c[i].tau;
                 gs_real ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
@@ -520,10 +548,6 @@ static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
 }
 
 #if GS_FIT_FAST
-#if defined(__GNUC__)
-typedef double gs_v2d __attribute__((vector_size(16)));
-#endif
-
 /* The double T with r < T exactly when (float)r < key, for r >= 0 and key a float
  * >= 0: (float)r falls below key when r lies below the midpoint of key and the float
  * before it, or on it when that float is even (ties round to even). Both floats and
