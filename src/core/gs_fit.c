@@ -715,6 +715,10 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
     gs_real g0 = GS_R(0.0), g1 = GS_R(0.0), g2 = GS_R(0.0), g3 = GS_R(0.0), g4 = GS_R(0.0);
     gs_real bx0 = g0, bx1 = g0, bx2 = g0, by0 = g0, by1 = g0, by2 = g0, eex = g0, eey = g0;
     uint32_t n = 0, word = 0, i;
+#if defined(__GNUC__)
+    gs_v2d p0 = {base->c[0], base->c[3]}, p1 = {base->c[1], base->c[4]}, p2 = {base->c[2], base->c[5]};
+    gs_v2d ee = {g0, g0}, v0 = ee, v1 = ee, v2 = ee;
+#endif
     for (i = 0; i < wn->count; i++) {
         const gs_fsamp *s = &wn->cache[i];
         float w = s->w;
@@ -735,22 +739,43 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
         }
         if (w > 0.0f) {
             gs_real tau = s->tau, wr = (gs_real)w, wt;
-            gs_real ex = (gs_real)s->xy_px[0] - (base->c[0] + tau * (base->c[1] + tau * base->c[2]));
-            gs_real ey = (gs_real)s->xy_px[1] - (base->c[3] + tau * (base->c[4] + tau * base->c[5]));
             word |= 1u << (i & 31u);
-            eex += wr * ex * ex;
-            eey += wr * ey * ey;
-            g0 += wr;
-            bx0 += wr * ex;
-            by0 += wr * ey;
-            wt = wr * tau;
-            g1 += wt;
-            bx1 += wt * ex;
-            by1 += wt * ey;
-            wt *= tau;
-            g2 += wt;
-            bx2 += wt * ex;
-            by2 += wt * ey;
+#if defined(__GNUC__)
+            {
+                /* x and y side by side: the same operations on each */
+                gs_v2d tv = {tau, tau}, wv = {wr, wr}, wtv;
+                gs_v2d e = (gs_v2d){(gs_real)s->xy_px[0], (gs_real)s->xy_px[1]} - (p0 + tv * (p1 + tv * p2));
+                ee += wv * e * e;
+                g0 += wr;
+                v0 += wv * e;
+                wt = wr * tau;
+                wtv = (gs_v2d){wt, wt};
+                g1 += wt;
+                v1 += wtv * e;
+                wt *= tau;
+                wtv = (gs_v2d){wt, wt};
+                g2 += wt;
+                v2 += wtv * e;
+            }
+#else
+            {
+                gs_real ex = (gs_real)s->xy_px[0] - (base->c[0] + tau * (base->c[1] + tau * base->c[2]));
+                gs_real ey = (gs_real)s->xy_px[1] - (base->c[3] + tau * (base->c[4] + tau * base->c[5]));
+                eex += wr * ex * ex;
+                eey += wr * ey * ey;
+                g0 += wr;
+                bx0 += wr * ex;
+                by0 += wr * ey;
+                wt = wr * tau;
+                g1 += wt;
+                bx1 += wt * ex;
+                by1 += wt * ey;
+                wt *= tau;
+                g2 += wt;
+                bx2 += wt * ex;
+                by2 += wt * ey;
+            }
+#endif
             wt *= tau;
             g3 += wt;
             wt *= tau;
@@ -764,6 +789,16 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
             word = 0;
         }
     }
+#if defined(__GNUC__)
+    eex = ee[0];
+    eey = ee[1];
+    bx0 = v0[0];
+    by0 = v0[1];
+    bx1 = v1[0];
+    by1 = v1[1];
+    bx2 = v2[0];
+    by2 = v2[1];
+#endif
     a->g[0] = g0;
     a->g[1] = g1;
     a->g[2] = g2;
