@@ -35,6 +35,7 @@
 #if GS_FIT_FAST && defined(__GNUC__)
 /* two doubles, for the hot loops over a cached window (element-wise IEEE, as scalars) */
 typedef double gs_v2d __attribute__((vector_size(16)));
+typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lanes: -1 true, 0 false */
 #endif
 
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
@@ -585,16 +586,18 @@ static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key
     double T = below_key(med_key);
     uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
 #if defined(__GNUC__)
-    gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5};
+    gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5}, vT = {T, T};
     for (; j + 1u < m; j += 2u) {
         gs_v2d tau, vx, vy, ex, ey, r2;
+        gs_v2l lt;
         memcpy(&tau, &t[j], sizeof tau);
         memcpy(&vx, &x[j], sizeof vx);
         memcpy(&vy, &y[j], sizeof vy);
         ex = vx - (v0 + tau * (v1 + tau * v2));
         ey = vy - (v3 + tau * (v4 + tau * v5));
         r2 = ex * ex + ey * ey;
-        less += (uint32_t)(r2[0] < T) + (uint32_t)(r2[1] < T);
+        lt = r2 < vT;
+        less -= (uint32_t)(lt[0] + lt[1]);
         if (less >= need) {
             return true;
         }
@@ -888,6 +891,9 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
 static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint32_t kc, gs_par *p)
 {
     gs_fsamp a, b, c;
+    if (GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE) {
+        return par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], p); /* every sample usable, cached */
+    }
     /* the window was checked to be held, and usable_index finds usable samples */
     return par_through(win_at(wn, usable_index(wn, ka), &a), win_at(wn, usable_index(wn, kb), &b),
                        win_at(wn, usable_index(wn, kc), &c), p);
