@@ -444,8 +444,21 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
         /* (a size of 0 gates as an unknown one: plausible_fall needs it positive) */
         return s && size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
     }
+#ifndef __OPTIMIZE_SIZE__
+    {
+        /* stand_size without the standard error it would compute and drop here */
+        float tmp[GS_STAND_KEEP];
+        const float *v = f->stand_n >= 3 ? f->stand_size : f->loose_size;
+        uint32_t n = f->stand_n >= 3 ? f->stand_n : f->loose_n;
+        if (n < 3) return NAN;
+        if (n > GS_STAND_KEEP) n = GS_STAND_KEEP;
+        memcpy(tmp, v, n * sizeof tmp[0]);
+        return median_f(tmp, n);
+    }
+#else
     gs_real se;
     return stand_size(f, &se);
+#endif
 }
 
 /* the fit's apex: where its velocity along its own gravity is zero (GS_T_NONE unknown) */
