@@ -1295,7 +1295,18 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
+#ifndef __OPTIMIZE_SIZE__
+    /* usable_at reading only what the test and the speed need */
+    const gs_sample *rs = gs_ring_at(f->ring, idx - k);
+    if (!rs) return NAN;
+    b_b.t_us = gs_ring_sample_t_us(f->ring, rs);
+    b_b.x_px = rs->x_px;
+    b_b.y_px = rs->y_px;
+    b_b.w = gs_sample_w(rs);
+    const gs_sample_full *b = usable(&b_b) ? &b_b : NULL;
+#else
     const gs_sample_full *b = usable_at(f, idx - k, &b_b);
+#endif
     if (!b || s->t_us <= b->t_us) return NAN;
     return GS_FABSR(u - u_of(f, b)) / gs_time_span_s(s->t_us, b->t_us);
 }
