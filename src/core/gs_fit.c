@@ -998,6 +998,26 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
 {
     gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
+#if GS_FIT_FAST
+    if (wn->count <= GS_FIT_CACHE) {
+        /* the same sum over the cache, the curve in registers */
+        const gs_fsamp *c = wn->cache;
+        gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
+        for (i = 0; i < wn->count; i++) {
+            gs_real tau, ex, ey, u, v;
+            if (!(c[i].w > 0.0f)) {
+                continue;
+            }
+            tau = c[i].tau;
+            ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
+            ey = (gs_real)c[i].xy_px[1] - (c3 + tau * (c4 + tau * c5));
+            u = sqrt(ex * ex + ey * ey) / cut;
+            v = GS_R(1.0) - u * u;
+            loss += (gs_real)c[i].w * (u < GS_R(1.0) ? GS_R(1.0) - v * v * v : GS_R(1.0));
+        }
+        return loss;
+    }
+#endif
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
