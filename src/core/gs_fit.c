@@ -587,6 +587,28 @@ static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key
     uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
 #if defined(__GNUC__)
     gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5}, vT = {T, T};
+    for (; j + 3u < m; j += 4u) {
+        gs_v2d ta, tb, xa, xb, ya, yb, exa, exb, eya, eyb;
+        gs_v2l lt;
+        memcpy(&ta, &t[j], sizeof ta);
+        memcpy(&tb, &t[j + 2u], sizeof tb);
+        memcpy(&xa, &x[j], sizeof xa);
+        memcpy(&xb, &x[j + 2u], sizeof xb);
+        memcpy(&ya, &y[j], sizeof ya);
+        memcpy(&yb, &y[j + 2u], sizeof yb);
+        exa = xa - (v0 + ta * (v1 + ta * v2));
+        exb = xb - (v0 + tb * (v1 + tb * v2));
+        eya = ya - (v3 + ta * (v4 + ta * v5));
+        eyb = yb - (v3 + tb * (v4 + tb * v5));
+        lt = (exa * exa + eya * eya < vT) + (exb * exb + eyb * eyb < vT);
+        less -= (uint32_t)(lt[0] + lt[1]);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 4u - less > room) {
+            return false;
+        }
+    }
     for (; j + 1u < m; j += 2u) {
         gs_v2d tau, vx, vy, ex, ey, r2;
         gs_v2l lt;
