@@ -287,6 +287,7 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
     if (GS_WITH_COCO17 && !blaze) {
         /* the same as the loop below, without its per-keypoint layout choice */
         uint32_t obs = 0;
+#pragma GCC unroll 17
         for (int k = 0; k < 17; k++) {
             const gs_kp *q = &kp[k];
             if (kp_usable(q, min_conf)) {
@@ -479,6 +480,9 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
 
 static void add_limbs(frame *f, const seg_table *tb)
 {
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 12 /* hosts: each segment's kind and joints constant, its tests folded */
+#endif
     for (size_t i = 0; i < sizeof k_limb_segs / sizeof k_limb_segs[0]; i++) {
         const seg_def *d = &k_limb_segs[i];
         add_limb_segment(f, d, tb->mass_pct[d->seg], tb->c[d->seg]);
@@ -503,6 +507,9 @@ static const uint8_t k_marks[][2] = {
 static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 {
     wsum g[2] = { { 0.0f, 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f } }; /* head, feet; e: height fraction */
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 11 /* hosts: each landmark's kind constant */
+#endif
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
         if (!(f->obs & BIT(k))) {
@@ -557,6 +564,9 @@ static float min_nan(float acc, float v)
 static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axis_from_body, vec2 up)
 {
     float knee = NAN, other = NAN;
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 2 /* hosts: each side's bits constant */
+#endif
     for (int i = 0; i < 2; i++) { /* the right keypoint follows the left one */
         int sh = K_LSHO + i, hp = K_LHIP + i, kn = K_LKNE + i, an = K_LANK + i;
         if (!all_in(f->obs >> i, BIT(K_LHIP) | BIT(K_LKNE) | BIT(K_LANK))) {
@@ -606,6 +616,9 @@ static void mirror_limbs(frame *f, vec2 axis, float trunk_len)
     /* no pair seen: one side hidden, i.e. a lateral view */
     float across = isnan(width) ? 1.0f : 1.0f - 2.0f * ramp(width, LATERAL_MAX_WIDTH, MIRROR_MIN_WIDTH);
     static const uint8_t prox[8] = { K_LSHO, K_LELB, K_RSHO, K_RELB, K_LHIP, K_LKNE, K_RHIP, K_RKNE };
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 8 /* hosts: each joint's bits constant */
+#endif
     for (int i = 0; i < 8; i++) {
         mirror_joint(f, prox[i], axis, across);
     }
