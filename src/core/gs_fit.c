@@ -526,6 +526,7 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
     return sqrt((gs_real)v);
 }
 
+#if GS_FIT_FAST
 /* p's median residual (median_resid) is below med: at least k + 1 of the m usable
  * samples lie nearer than med (sqrt is monotone), counted with early exits. */
 static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
@@ -547,6 +548,7 @@ static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
     }
     return false;
 }
+#endif
 
 #if GS_FIT_FAST
 /* The double T with r < T exactly when (float)r < key, for r >= 0 and key a float
