@@ -7,8 +7,13 @@
 
 #include "gravscale/gs_com.h"
 
-/* one copy of a helper called from several places: smaller code on the Cortex-M4 */
+/* one copy of a helper called from several places: smaller code on the Cortex-M4 (where
+ * the build optimises for size); elsewhere the compiler inlines what pays */
+#ifdef __OPTIMIZE_SIZE__
 #define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
 
 #define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
 
@@ -205,6 +210,7 @@ static float kp_dist(const frame *f, int a, int b)
     return v_len(kp_diff(f, a, b));
 }
 
+#ifdef __OPTIMIZE_SIZE__
 /* Angle at keypoint b between b->a and b->c in degrees, NaN when a leg has no length. */
 static float angle_deg(const frame *f, int a, int b, int c)
 {
@@ -215,6 +221,40 @@ static float angle_deg(const frame *f, int a, int b, int c)
     }
     return acos_deg(v_dot(u, v) / (lu * lv));
 }
+#else
+/* The cosine of angle_deg's angle, NaN when a leg has no length. */
+static float angle_cos(const frame *f, int a, int b, int c)
+{
+    vec2 u = kp_diff(f, a, b), v = kp_diff(f, c, b);
+    float lu = v_len(u), lv = v_len(v);
+    if (!(lu > 0.0f) || !(lv > 0.0f)) {
+        return NAN;
+    }
+    return v_dot(u, v) / (lu * lv);
+}
+
+/* ramp(acos_deg(cs), x0, x1) with c0, c1 the cosines of x0, x1 degrees: where the cosine
+ * lies clearly beyond either end the ramp is exactly 0 or 1 and no acos is needed (acos
+ * falls as the cosine rises; 1e-4 in the cosine is at least 0.005 degree there, far beyond
+ * the rounding of acosf and of the constants). */
+static float ramp_acos(float cs, float x0, float x1, float c0, float c1)
+{
+    float s = x0 < x1 ? 1.0f : -1.0f;
+    if (s * (cs - c0) > 1e-4f) {
+        return 0.0f;
+    }
+    if (s * (c1 - cs) > 1e-4f) {
+        return 1.0f;
+    }
+    return ramp(acos_deg(cs), x0, x1);
+}
+#define COS_KNEE_0 -0.8660254f /* cos 150 deg */
+#define COS_KNEE_1 -0.9848078f /* cos 170 deg */
+#define COS_HIP_0 -0.7660444f  /* cos 140 deg */
+#define COS_HIP_1 -0.9659258f  /* cos 165 deg */
+#define COS_TILT_0 0.8191520f  /* cos 35 deg */
+#define COS_TILT_1 0.9848078f  /* cos 10 deg */
+#endif
 
 /* The same keypoint on the other side of the body (left odd, right even). */
 static int other_side(int k)
@@ -243,6 +283,34 @@ static bool is_rebuilt(const frame *f, int a, int b)
 static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
 {
     f->obs = 0;
+#ifndef __OPTIMIZE_SIZE__
+    if (GS_WITH_COCO17 && !blaze) {
+        /* the same as the loop below, without its per-keypoint layout choice */
+        uint32_t obs = 0;
+#pragma GCC unroll 17
+        for (int k = 0; k < 17; k++) {
+            const gs_kp *q = &kp[k];
+            if (kp_usable(q, min_conf)) {
+                obs |= BIT(k);
+                f->c[k] = conf01(q->c);
+                f->p[k] = (vec2){ q->x_px, q->y_px };
+            } else {
+                f->c[k] = 0.0f;
+                f->p[k] = (vec2){ NAN, NAN };
+            }
+        }
+        for (int k = 17; k < K_N; k++) {
+            f->c[k] = 0.0f;
+            f->p[k] = (vec2){ NAN, NAN };
+        }
+        f->obs = obs;
+        f->have = obs;
+        f->blaze = blaze;
+        f->used = 0;
+        f->com = (wsum){ 0.0f, 0.0f, 0.0f, 0.0f };
+        return;
+    }
+#endif
     for (int k = 0; k < K_N; k++) {
         f->c[k] = 0.0f;
         f->p[k] = (vec2){ NAN, NAN };
@@ -412,6 +480,9 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
 
 static void add_limbs(frame *f, const seg_table *tb)
 {
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 12 /* hosts: each segment's kind and joints constant, its tests folded */
+#endif
     for (size_t i = 0; i < sizeof k_limb_segs / sizeof k_limb_segs[0]; i++) {
         const seg_def *d = &k_limb_segs[i];
         add_limb_segment(f, d, tb->mass_pct[d->seg], tb->c[d->seg]);
@@ -436,6 +507,9 @@ static const uint8_t k_marks[][2] = {
 static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 {
     wsum g[2] = { { 0.0f, 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f, 0.0f } }; /* head, feet; e: height fraction */
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 11 /* hosts: each landmark's kind constant */
+#endif
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
         if (!(f->obs & BIT(k))) {
@@ -490,15 +564,25 @@ static float min_nan(float acc, float v)
 static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axis_from_body, vec2 up)
 {
     float knee = NAN, other = NAN;
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 2 /* hosts: each side's bits constant */
+#endif
     for (int i = 0; i < 2; i++) { /* the right keypoint follows the left one */
         int sh = K_LSHO + i, hp = K_LHIP + i, kn = K_LKNE + i, an = K_LANK + i;
         if (!all_in(f->obs >> i, BIT(K_LHIP) | BIT(K_LKNE) | BIT(K_LANK))) {
             continue;
         }
+#ifndef __OPTIMIZE_SIZE__
+        knee = min_nan(knee, ramp_acos(angle_cos(f, hp, kn, an), KNEE_DEG_0, KNEE_DEG_1, COS_KNEE_0, COS_KNEE_1));
+        if ((f->obs >> i) & BIT(K_LSHO)) {
+            other = min_nan(other, ramp_acos(angle_cos(f, sh, hp, kn), HIP_DEG_0, HIP_DEG_1, COS_HIP_0, COS_HIP_1));
+        }
+#else
         knee = min_nan(knee, ramp(angle_deg(f, hp, kn, an), KNEE_DEG_0, KNEE_DEG_1));
         if ((f->obs >> i) & BIT(K_LSHO)) {
             other = min_nan(other, ramp(angle_deg(f, sh, hp, kn), HIP_DEG_0, HIP_DEG_1));
         }
+#endif
         if (trunk_len > 0.0f) {
             float leg = kp_dist(f, hp, kn) + kp_dist(f, kn, an);
             other = min_nan(other, ramp(leg / trunk_len, LEG_TRUNK_0, LEG_TRUNK_1));
@@ -508,8 +592,13 @@ static float upright_score(const frame *f, vec2 trunk, float trunk_len, bool axi
         return NAN; /* legs missing: cannot tell */
     }
     if (axis_from_body && trunk_len > 0.0f) {
+#ifndef __OPTIMIZE_SIZE__
+        other = min_nan(other, ramp_acos(v_dot(trunk, up) / trunk_len, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1, COS_TILT_0,
+                                         COS_TILT_1));
+#else
         float tilt_deg = acos_deg(v_dot(trunk, up) / trunk_len);
         other = min_nan(other, ramp(tilt_deg, TRUNK_TILT_DEG_0, TRUNK_TILT_DEG_1));
+#endif
     }
     return min_nan(knee, other);
 }
@@ -527,6 +616,9 @@ static void mirror_limbs(frame *f, vec2 axis, float trunk_len)
     /* no pair seen: one side hidden, i.e. a lateral view */
     float across = isnan(width) ? 1.0f : 1.0f - 2.0f * ramp(width, LATERAL_MAX_WIDTH, MIRROR_MIN_WIDTH);
     static const uint8_t prox[8] = { K_LSHO, K_LELB, K_RSHO, K_RELB, K_LHIP, K_LKNE, K_RHIP, K_RKNE };
+#ifndef __OPTIMIZE_SIZE__
+#pragma GCC unroll 8 /* hosts: each joint's bits constant */
+#endif
     for (int i = 0; i < 8; i++) {
         mirror_joint(f, prox[i], axis, across);
     }
@@ -582,12 +674,19 @@ static void com_result(const frame *f, float total, gs_com_out *out)
     vec2 com = wsum_mean(&f->com);
     float csum = 0.0f;
     int n = 0;
+#ifndef __OPTIMIZE_SIZE__
+    for (uint32_t u = f->used; u != 0u; u &= u - 1u) { /* the set bits in ascending order, as below */
+        csum += f->c[__builtin_ctz(u)];
+        n++;
+    }
+#else
     for (int k = 0; k < K_N; k++) {
         if (f->used & BIT(k)) {
             csum += f->c[k];
             n++;
         }
     }
+#endif
     float frac = f->com.e / total;
     float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
     /* a segment missing outright (not even rebuilt from its mirror, e.g. the head

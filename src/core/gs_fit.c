@@ -24,6 +24,20 @@
 #define GS_FIT_FAST 1
 #endif
 
+/* Hosts: GCC's straight-line vectoriser pairs a sample's sums and shuffles them for
+ * every sample (more instructions, not fewer) */
+#if GS_FIT_FAST && defined(__GNUC__) && !defined(__clang__)
+#define GS_NO_SLP __attribute__((optimize("no-tree-slp-vectorize")))
+#else
+#define GS_NO_SLP
+#endif
+
+#if GS_FIT_FAST && defined(__GNUC__)
+/* two doubles, for the hot loops over a cached window (element-wise IEEE, as scalars) */
+typedef double gs_v2d __attribute__((vector_size(16)));
+typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lanes: -1 true, 0 false */
+#endif
+
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
 #define GS_FIT_TUKEY_C GS_R(4.685)
 /* Consistency factor that turns a median absolute residual into a Gaussian SD. */
@@ -268,6 +282,8 @@ typedef struct {
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
     uint32_t *key;            /* the median's selection scratch */
+    float *med_key;           /* fast builds: the last median's squared residual, as a float */
+    gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y (3 rows of m) */
 } gs_win;
 
 static uint32_t xorshift32(uint32_t *state)
@@ -374,30 +390,38 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
 }
 
 /* The k-th smallest of n float bit patterns (non-negative floats order like their
- * bits): a radix selection, 4 bits a pass, each pass keeping only the keys that
- * share the digits chosen so far (key is overwritten). The same float as sorting. */
+ * bits; key is reordered): Wirth's selection, partitions about the k-th slot until
+ * it holds the key a sort would put there. The same float as sorting. */
 static float select_key(uint32_t *key, uint32_t n, uint32_t k)
 {
-    int shift;
+    int32_t l = 0, r = (int32_t)n - 1, kk = (int32_t)k; /* n <= GS_FIT_CACHE */
     float v;
-    for (shift = 28; shift >= 0 && n > 1u; shift -= 4) {
-        uint32_t cnt[16] = {0};
-        uint32_t d = 0, i, j = 0;
-        for (i = 0; i < n; i++) {
-            cnt[(key[i] >> (uint32_t)shift) & 15u]++;
-        }
-        while (d < 15u && k >= cnt[d]) {
-            k -= cnt[d];
-            d++;
-        }
-        for (i = 0; i < n; i++) {
-            if (((key[i] >> (uint32_t)shift) & 15u) == d) {
-                key[j++] = key[i];
+    while (l < r) {
+        uint32_t x = key[kk];
+        int32_t i = l, j = r;
+        do {
+            while (key[i] < x) {
+                i++;
             }
+            while (x < key[j]) {
+                j--;
+            }
+            if (i <= j) {
+                uint32_t t = key[i];
+                key[i] = key[j];
+                key[j] = t;
+                i++;
+                j--;
+            }
+        } while (i <= j);
+        if (j < kk) {
+            l = i;
         }
-        n = j;
+        if (kk < i) {
+            r = j;
+        }
     }
-    memcpy(&v, &key[0], sizeof v);
+    memcpy(&v, &key[kk], sizeof v);
     return v;
 }
 
@@ -415,6 +439,51 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
     if (left == 0) {
         return (gs_real)NAN;
     }
+#if GS_FIT_FAST
+    if (wn->count <= GS_FIT_CACHE) {
+        /* every usable sample cached: one pass collects all keys (no prefix yet) */
+        const gs_fsamp *c = wn->cache;
+        gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
+        uint32_t n = 0;
+#if defined(__GNUC__)
+        if (!GS_REAL_IS_FLOAT && wn->m == wn->count) {
+            /* every sample usable: the rows of median_below_cached, two at a time */
+            const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
+            gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5};
+            for (i = 0; i + 1u < wn->count; i += 2u) {
+                gs_v2d tau, vx, vy, ex, ey, r2;
+                float f0, f1;
+                memcpy(&tau, &t[i], sizeof tau);
+                memcpy(&vx, &x[i], sizeof vx);
+                memcpy(&vy, &y[i], sizeof vy);
+                ex = vx - (v0 + tau * (v1 + tau * v2));
+                ey = vy - (v3 + tau * (v4 + tau * v5));
+                r2 = ex * ex + ey * ey;
+                memcpy(&wn->r2[i], &r2, sizeof r2);
+                f0 = (float)r2[0];
+                f1 = (float)r2[1];
+                memcpy(&wn->key[i], &f0, sizeof f0);
+                memcpy(&wn->key[i + 1u], &f1, sizeof f1);
+            }
+            n = i;
+        }
+#endif
+        for (i = n; i < wn->count; i++) {
+            if (c[i].w > 0.0f) {
+                gs_real tau = c[i].tau;
+                gs_real ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
+                gs_real ey = (gs_real)c[i].xy_px[1] - (c3 + tau * (c4 + tau * c5));
+                gs_real r2 = ex * ex + ey * ey;
+                float f = (float)r2;
+                wn->r2[i] = r2;
+                memcpy(&wn->key[n++], &f, sizeof f);
+            }
+        }
+        v = select_key(wn->key, n, (n - 1) / 2);
+        *wn->med_key = v;
+        return sqrt((gs_real)v);
+    }
+#endif
     k = (left - 1) / 2; /* lower median: exact for odd m, robust enough for even m */
     while (mask != ~0u) {
         uint32_t cnt[16] = {0};
@@ -457,6 +526,7 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
     return sqrt((gs_real)v);
 }
 
+#if GS_FIT_FAST
 /* p's median residual (median_resid) is below med: at least k + 1 of the m usable
  * samples lie nearer than med (sqrt is monotone), counted with early exits. */
 static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
@@ -478,6 +548,103 @@ static bool median_below(const gs_win *wn, const gs_par *p, gs_real med)
     }
     return false;
 }
+#endif
+
+#if GS_FIT_FAST
+/* The double T with r < T exactly when (float)r < key, for r >= 0 and key a float
+ * >= 0: (float)r falls below key when r lies below the midpoint of key and the float
+ * before it, or on it when that float is even (ties round to even). Both floats and
+ * their midpoint are exact in double. */
+static double below_key(float key)
+{
+    uint32_t kb;
+    uint64_t mb;
+    float lo;
+    double mid;
+    memcpy(&kb, &key, sizeof kb);
+    if (kb == 0u) {
+        return 0.0; /* nothing rounds below +0 */
+    }
+    kb--;
+    memcpy(&lo, &kb, sizeof lo);
+    mid = ((double)lo + (double)key) * 0.5;
+    if ((kb & 1u) == 0u) {
+        memcpy(&mb, &mid, sizeof mb);
+        mb++; /* the next double up: r < it when r <= mid */
+        memcpy(&mid, &mb, sizeof mid);
+    }
+    return mid;
+}
+
+/* median_below over a window the cache holds, in double: sqrt((double)a) < sqrt((double)b)
+ * exactly when a < b for floats a, b >= 0 (adjacent floats differ by far more than a
+ * double's rounding), so each squared residual's float is compared with the median's
+ * (through below_key, without the conversion). The usable samples in rows, two at a time
+ * where the compiler has vectors; the decision only counts, in any order. */
+static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key)
+{
+    const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
+    gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
+    double T = below_key(med_key);
+    uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
+#if defined(__GNUC__)
+    gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5}, vT = {T, T};
+    for (; j + 3u < m; j += 4u) {
+        gs_v2d ta, tb, xa, xb, ya, yb, exa, exb, eya, eyb;
+        gs_v2l lt;
+        memcpy(&ta, &t[j], sizeof ta);
+        memcpy(&tb, &t[j + 2u], sizeof tb);
+        memcpy(&xa, &x[j], sizeof xa);
+        memcpy(&xb, &x[j + 2u], sizeof xb);
+        memcpy(&ya, &y[j], sizeof ya);
+        memcpy(&yb, &y[j + 2u], sizeof yb);
+        exa = xa - (v0 + ta * (v1 + ta * v2));
+        exb = xb - (v0 + tb * (v1 + tb * v2));
+        eya = ya - (v3 + ta * (v4 + ta * v5));
+        eyb = yb - (v3 + tb * (v4 + tb * v5));
+        lt = (exa * exa + eya * eya < vT) + (exb * exb + eyb * eyb < vT);
+        less -= (uint32_t)(lt[0] + lt[1]);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 4u - less > room) {
+            return false;
+        }
+    }
+    for (; j + 1u < m; j += 2u) {
+        gs_v2d tau, vx, vy, ex, ey, r2;
+        gs_v2l lt;
+        memcpy(&tau, &t[j], sizeof tau);
+        memcpy(&vx, &x[j], sizeof vx);
+        memcpy(&vy, &y[j], sizeof vy);
+        ex = vx - (v0 + tau * (v1 + tau * v2));
+        ey = vy - (v3 + tau * (v4 + tau * v5));
+        r2 = ex * ex + ey * ey;
+        lt = r2 < vT;
+        less -= (uint32_t)(lt[0] + lt[1]);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 2u - less > room) {
+            return false;
+        }
+    }
+#endif
+    for (; j < m; j++) {
+        gs_real tau = t[j];
+        gs_real ex = x[j] - (c0 + tau * (c1 + tau * c2));
+        gs_real ey = y[j] - (c3 + tau * (c4 + tau * c5));
+        less += (uint32_t)(ex * ex + ey * ey < T);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 1u - less > room) {
+            return false;
+        }
+    }
+    return false;
+}
+#endif
 
 /* Tukey biweight of a residual norm r with cut-off cut. */
 static gs_real tukey(gs_real r, gs_real cut)
@@ -566,6 +733,116 @@ static void wsums_to_fit(const gs_wsums *a, gs_fit *f)
     f->n = a->n;
 }
 
+#if GS_FIT_FAST
+/* wsums_add over a window the cache holds, in double: the same products summed in the
+ * same order, in registers, and the kept bits set a word at a time. */
+GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const gs_par *base, w_mode mode, gs_real cut,
+                         uint32_t *keep, const gs_real *r2, gs_wsums *a)
+{
+    gs_real g0 = GS_R(0.0), g1 = GS_R(0.0), g2 = GS_R(0.0), g3 = GS_R(0.0), g4 = GS_R(0.0);
+    gs_real bx0 = g0, bx1 = g0, bx2 = g0, by0 = g0, by1 = g0, by2 = g0, eex = g0, eey = g0;
+    uint32_t n = 0, word = 0, i;
+#if defined(__GNUC__)
+    gs_v2d p0 = {base->c[0], base->c[3]}, p1 = {base->c[1], base->c[4]}, p2 = {base->c[2], base->c[5]};
+    gs_v2d ee = {g0, g0}, v0 = ee, v1 = ee, v2 = ee;
+#endif
+    for (i = 0; i < wn->count; i++) {
+        const gs_fsamp *s = &wn->cache[i];
+        float w = s->w;
+        if (!(w > 0.0f)) {
+            w = 0.0f;
+        } else if (mode == W_TUKEY && r2) {
+            /* sample_weight's Tukey weight from the residual the median kept */
+            gs_real r = sqrt(r2[i]), u;
+            if (!(r < cut)) {
+                w = 0.0f;
+            } else {
+                u = r / cut;
+                u = GS_R(1.0) - u * u;
+                w = (float)((gs_real)s->w * (u * u));
+            }
+        } else if (mode != W_PRIOR) {
+            w = sample_weight(s, model, mode, cut, r2 ? &r2[i] : NULL);
+        }
+        if (w > 0.0f) {
+            gs_real tau = s->tau, wr = (gs_real)w, wt;
+            word |= 1u << (i & 31u);
+#if defined(__GNUC__)
+            {
+                /* x and y side by side: the same operations on each */
+                gs_v2d tv = {tau, tau}, wv = {wr, wr}, wtv;
+                gs_v2d e = (gs_v2d){(gs_real)s->xy_px[0], (gs_real)s->xy_px[1]} - (p0 + tv * (p1 + tv * p2));
+                ee += wv * e * e;
+                g0 += wr;
+                v0 += wv * e;
+                wt = wr * tau;
+                wtv = (gs_v2d){wt, wt};
+                g1 += wt;
+                v1 += wtv * e;
+                wt *= tau;
+                wtv = (gs_v2d){wt, wt};
+                g2 += wt;
+                v2 += wtv * e;
+            }
+#else
+            {
+                gs_real ex = (gs_real)s->xy_px[0] - (base->c[0] + tau * (base->c[1] + tau * base->c[2]));
+                gs_real ey = (gs_real)s->xy_px[1] - (base->c[3] + tau * (base->c[4] + tau * base->c[5]));
+                eex += wr * ex * ex;
+                eey += wr * ey * ey;
+                g0 += wr;
+                bx0 += wr * ex;
+                by0 += wr * ey;
+                wt = wr * tau;
+                g1 += wt;
+                bx1 += wt * ex;
+                by1 += wt * ey;
+                wt *= tau;
+                g2 += wt;
+                bx2 += wt * ex;
+                by2 += wt * ey;
+            }
+#endif
+            wt *= tau;
+            g3 += wt;
+            wt *= tau;
+            g4 += wt;
+            n++;
+        }
+        if ((i & 31u) == 31u || i + 1u == wn->count) {
+            /* bits past count keep their values, as keep_set leaves them */
+            uint32_t mask = (i & 31u) == 31u ? ~0u : (1u << ((i & 31u) + 1u)) - 1u;
+            keep[i >> 5] = (keep[i >> 5] & ~mask) | word;
+            word = 0;
+        }
+    }
+#if defined(__GNUC__)
+    eex = ee[0];
+    eey = ee[1];
+    bx0 = v0[0];
+    by0 = v0[1];
+    bx1 = v1[0];
+    by1 = v1[1];
+    bx2 = v2[0];
+    by2 = v2[1];
+#endif
+    a->g[0] = g0;
+    a->g[1] = g1;
+    a->g[2] = g2;
+    a->g[3] = g3;
+    a->g[4] = g4;
+    a->b[0][0] = bx0;
+    a->b[0][1] = bx1;
+    a->b[0][2] = bx2;
+    a->b[1][0] = by0;
+    a->b[1][1] = by1;
+    a->b[1][2] = by2;
+    a->ee[0] = eex;
+    a->ee[1] = eey;
+    a->n = n;
+}
+#endif
+
 /* Weighted LS over the window; flags each sample with a positive weight in keep, the
  * tau-basis parabola to p. r2: the samples' squared residuals from model, or NULL.
  * In double the normal equations (sums about model, when there is one) lose nothing
@@ -584,6 +861,13 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
         base = *model;
     }
     fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
+#if GS_FIT_FAST
+    if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE) {
+        wsums_cached(wn, model, &base, mode, cut, keep, r2, &a);
+        wsums_to_fit(&a, &f);
+        return solve_par(&f, out, p, &base);
+    }
+#endif
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
@@ -631,6 +915,9 @@ static uint32_t usable_index(const gs_win *wn, uint32_t k)
 static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint32_t kc, gs_par *p)
 {
     gs_fsamp a, b, c;
+    if (GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE) {
+        return par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], p); /* every sample usable, cached */
+    }
     /* the window was checked to be held, and usable_index finds usable samples */
     return par_through(win_at(wn, usable_index(wn, ka), &a), win_at(wn, usable_index(wn, kb), &b),
                        win_at(wn, usable_index(wn, kc), &c), p);
@@ -645,6 +932,9 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     uint32_t state = GS_FIT_SEED_IRLS;
     uint32_t third = m / 3, k;
     bool found = false;
+#if GS_FIT_FAST
+    float best_key = 0.0f; /* *best_med's squared residual as a float, once found */
+#endif
     *best_med = (gs_real)INFINITY;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
         uint32_t ka = rand_below(&state, third);
@@ -655,14 +945,20 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
-        if (GS_FIT_FAST && found && !median_below(wn, &p, *best_med)) {
+#if GS_FIT_FAST
+        if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_key)
+                                                                       : !median_below(wn, &p, *best_med))) {
             continue; /* cannot win: no median needed (m > 3 here: m = 3 stops at the first) */
         }
+#endif
         med = median_resid(wn, &p);
         if (med < *best_med) {
             *best_med = med;
             *best = p;
             found = true;
+#if GS_FIT_FAST
+            best_key = *wn->med_key;
+#endif
         }
         if (m == 3) {
             break;
@@ -726,6 +1022,26 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
 {
     gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
+#if GS_FIT_FAST
+    if (wn->count <= GS_FIT_CACHE) {
+        /* the same sum over the cache, the curve in registers */
+        const gs_fsamp *c = wn->cache;
+        gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
+        for (i = 0; i < wn->count; i++) {
+            gs_real tau, ex, ey, u, v;
+            if (!(c[i].w > 0.0f)) {
+                continue;
+            }
+            tau = c[i].tau;
+            ex = (gs_real)c[i].xy_px[0] - (c0 + tau * (c1 + tau * c2));
+            ey = (gs_real)c[i].xy_px[1] - (c3 + tau * (c4 + tau * c5));
+            u = sqrt(ex * ex + ey * ey) / cut;
+            v = GS_R(1.0) - u * u;
+            loss += (gs_real)c[i].w * (u < GS_R(1.0) ? GS_R(1.0) - v * v * v : GS_R(1.0));
+        }
+        return loss;
+    }
+#endif
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
@@ -875,6 +1191,19 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
             wn->cache[i].w = 0.0f;
         }
     }
+#if GS_FIT_FAST
+    if (!GS_REAL_IS_FLOAT && count <= GS_FIT_CACHE) {
+        uint32_t n = 0;
+        for (i = 0; i < count; i++) {
+            if (wn->cache[i].w > 0.0f) {
+                wn->soa[n] = wn->cache[i].tau;
+                wn->soa[GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[0];
+                wn->soa[2u * GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[1];
+                n++;
+            }
+        }
+    }
+#endif
     return GS_OK;
 }
 
@@ -899,12 +1228,20 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     gs_fsamp cache[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
     gs_real r2[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
     uint32_t key[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
+#if GS_FIT_FAST
+    float med_key = 0.0f;
+    gs_real soa[GS_REAL_IS_FLOAT ? 1u : 3u * GS_FIT_CACHE];
+#endif
     gs_win wn;
     uint32_t i;
     gs_status st;
     wn.cache = cache;
     wn.r2 = r2;
     wn.key = key;
+#if GS_FIT_FAST
+    wn.med_key = &med_key;
+    wn.soa = soa;
+#endif
     if (!out) {
         return GS_EINVAL;
     }

@@ -32,8 +32,13 @@
 #define DBG(...) ((void)0)
 #endif
 
-/* small helpers called from several places: one copy is smaller than inlining it everywhere */
+/* small helpers called from several places: one copy is smaller than inlining it everywhere
+ * (where the build optimises for size); elsewhere the compiler inlines what pays */
+#ifdef __OPTIMIZE_SIZE__
 #define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
 
 
 /* tuning: thresholds in units of the noise or of the object's size */
@@ -194,10 +199,37 @@ static void trace_fit(const gs_flight *f, const char *purpose, int64_t t0_us, in
     emit(f, &ev);
 }
 
-/* small sorts for medians of bounded arrays */
+/* Medians of bounded arrays of finite values (v is reordered). Where the build
+ * optimises for speed, the middle one by Wirth's selection (afterwards nothing before
+ * it is larger, nothing after it smaller; for even n the lower middle is the largest
+ * before it); where it optimises for size, an insertion sort. The same values. */
 static gs_real median_f(float *v, uint32_t n)
 {
     if (n == 0) return NAN;
+#ifndef __OPTIMIZE_SIZE__
+    int32_t l = 0, r = (int32_t)n - 1, k = (int32_t)(n / 2);
+    while (l < r) {
+        float x = v[k];
+        int32_t i = l, j = r;
+        do {
+            while (v[i] < x) i++;
+            while (x < v[j]) j--;
+            if (i <= j) {
+                float t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+                i++;
+                j--;
+            }
+        } while (i <= j);
+        if (j < k) l = i;
+        if (k < i) r = j;
+    }
+    if (n & 1u) return (gs_real)v[k];
+    float lo = v[0];
+    for (int32_t i = 1; i < k; i++) lo = v[i] > lo ? v[i] : lo;
+    return GS_R(0.5) * ((gs_real)lo + (gs_real)v[k]);
+#endif
     for (uint32_t i = 1; i < n; i++) {
         float x = v[i];
         uint32_t j = i;
@@ -417,8 +449,21 @@ static gs_real gate_size(const gs_flight *f, uint64_t idx)
         /* (a size of 0 gates as an unknown one: plausible_fall needs it positive) */
         return s && size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
     }
+#ifndef __OPTIMIZE_SIZE__
+    {
+        /* stand_size without the standard error it would compute and drop here */
+        float tmp[GS_STAND_KEEP];
+        const float *v = f->stand_n >= 3 ? f->stand_size : f->loose_size;
+        uint32_t n = f->stand_n >= 3 ? f->stand_n : f->loose_n;
+        if (n < 3) return NAN;
+        if (n > GS_STAND_KEEP) n = GS_STAND_KEEP;
+        memcpy(tmp, v, n * sizeof tmp[0]);
+        return median_f(tmp, n);
+    }
+#else
     gs_real se;
     return stand_size(f, &se);
+#endif
 }
 
 /* the fit's apex: where its velocity along its own gravity is zero (GS_T_NONE unknown) */
@@ -1250,7 +1295,18 @@ static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full
     if (k < 1) k = 1;
     if (idx < gs_ring_oldest(f->ring) + k) return NAN;
     gs_sample_full b_b;
+#ifndef __OPTIMIZE_SIZE__
+    /* usable_at reading only what the test and the speed need */
+    const gs_sample *rs = gs_ring_at(f->ring, idx - k);
+    if (!rs) return NAN;
+    b_b.t_us = gs_ring_sample_t_us(f->ring, rs);
+    b_b.x_px = rs->x_px;
+    b_b.y_px = rs->y_px;
+    b_b.w = gs_sample_w(rs);
+    const gs_sample_full *b = usable(&b_b) ? &b_b : NULL;
+#else
     const gs_sample_full *b = usable_at(f, idx - k, &b_b);
+#endif
     if (!b || s->t_us <= b->t_us) return NAN;
     return GS_FABSR(u - u_of(f, b)) / gs_time_span_s(s->t_us, b->t_us);
 }
