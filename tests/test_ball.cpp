@@ -320,6 +320,25 @@ BallSim tennis(double x_m, double z_m, double t_start)
 
 }  // namespace
 
+// The dilation by runs against cv::dilate with OpenCV's ellipse, on sparse and
+// dense masks, odd sizes, radii 0-16 and in place.
+void test_dilate_ellipse_matches_opencv(void)
+{
+    cv::RNG rng(11);
+    for (int r = 0; r <= 16; r++) {
+        for (int trial = 0; trial < 3; trial++) {
+            cv::Mat m(7 + rng.uniform(0, 60), 5 + rng.uniform(0, 70), CV_8U), noise(m.size(), CV_8U);
+            rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+            m = noise > (trial == 0 ? 250 : trial == 1 ? 200 : 60);
+            if (trial == 2) m.setTo(128, noise < 30);  // not only 0 and 255
+            cv::Mat want, got = m.clone();
+            cv::dilate(m, want, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+            gs::dilate_ellipse(got, got, r);
+            TEST_ASSERT_EQUAL_INT_MESSAGE(0, cv::countNonZero(got != want), "dilate_ellipse differs from cv::dilate");
+        }
+    }
+}
+
 // The one-pass motion measure against OpenCV's convert, difference, split and
 // maxima, over widths that leave every SIMD tail and backgrounds at half levels.
 void test_max_channel_diff_matches_opencv(void)
@@ -754,6 +773,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_config_keys);
     RUN_TEST(test_max_channel_diff_matches_opencv);
+    RUN_TEST(test_dilate_ellipse_matches_opencv);
     RUN_TEST(test_rendered_single_ball_centre_and_diameter);
     RUN_TEST(test_rendered_two_balls_with_distractors);
     RUN_TEST(test_rendered_fixed_colour);

@@ -247,6 +247,46 @@ Parabola fit_points(const std::vector<Pt> &pts, size_t last_n)
 
 }  // namespace
 
+// cv::dilate by MORPH_ELLIPSE of radius r, the same pixels: the disc's rows are
+// runs, so each distinct run is one fast rectangular dilation along x, and the rows
+// are their maxima shifted along y (OpenCV's general kernel visits every one of the
+// disc's points per pixel). Outside src counts as empty, as cv::dilate's border.
+void dilate_ellipse(const cv::Mat &src_in, cv::Mat &dst, int r)
+{
+    CV_Assert(src_in.type() == CV_8UC1 && r >= 0);
+    const cv::Mat src = src_in.isSubmatrix() ? src_in.clone() : src_in;
+    const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+    cv::Mat out = cv::Mat::zeros(src.size(), CV_8U);
+    std::vector<std::pair<std::pair<int, int>, cv::Mat>> runs;  // (first, last column) -> src dilated by it
+    for (int i = 0; i < k.rows; i++) {
+        const uchar *kr = k.ptr<uchar>(i);
+        int a = -1, b = -1;
+        for (int j = 0; j < k.cols; j++)
+            if (kr[j]) {
+                if (a < 0) a = j;
+                b = j;
+            }
+        if (a < 0) continue;
+        for (int j = a; j <= b; j++) CV_Assert(kr[j]);  // an ellipse's row is one run
+        const cv::Mat *h = nullptr;
+        for (const auto &run : runs)
+            if (run.first == std::make_pair(a, b)) h = &run.second;
+        if (!h) {
+            cv::Mat d;
+            cv::dilate(src, d, cv::Mat::ones(1, b - a + 1, CV_8U), cv::Point(r - a, 0));
+            runs.emplace_back(std::make_pair(a, b), d);
+            h = &runs.back().second;
+        }
+        // out(y) = max(out(y), h(y + i - r))
+        const int dy = i - r;
+        const int y0 = std::max(0, -dy), y1 = std::min(src.rows, src.rows - dy);
+        if (y1 <= y0) continue;
+        cv::Mat o = out.rowRange(y0, y1);
+        cv::max(o, h->rowRange(y0 + dy, y1 + dy), o);
+    }
+    dst = out;
+}
+
 // max over the channels of |image - round(background)|: the background rounded
 // to whole grey levels as convertTo would (the threshold is in whole levels), in
 // one pass instead of convert, difference, split and two maxima
@@ -412,7 +452,7 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
                                     cv::Size((int)std::ceil(b.box_s.width * inv), (int)std::ceil(b.box_s.height * inv))),
                       cv::Scalar(255), cv::FILLED);
     int k = (int)std::ceil(0.12 * dfull + 1.5 + inv);
-    cv::dilate(sup, sup, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
+    dilate_ellipse(sup, sup, k);
     cv::Mat I = bgr(roi), B = bg_full(roi);
     // colour of the ball: pass 1 from the most different pixels, pass 2 from
     // the pixels that pass 1 calls ball
@@ -575,7 +615,7 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
         if (best > 0) {
             cv::Mat keep = lab == best;
             int e = (int)std::ceil(0.06 * std::sqrt(best_area * 4.0 / CV_PI) + 2.0 * cfg.psf_sigma_px + 2.0);
-            cv::dilate(keep, keep, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * e + 1, 2 * e + 1)));
+            dilate_ellipse(keep, keep, e);
             alpha.setTo(0.0f, ~keep);
         }
     }
@@ -921,8 +961,7 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
     }
     std::vector<Blob> blobs;
     if (hue_set) {
-        const cv::Mat kern = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5));
-        constexpr int kReach = 2;  // the kernel's radius
+        constexpr int kReach = 2;  // the dilation's radius
         cv::Mat md;
         double h = hue / 2.0, tol = hue_tol / 2.0;
         int smin = (int)std::lround(sat_min * 255.0), vmin = (int)std::lround(val_min * 255.0);
@@ -942,7 +981,7 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
             // the dilation's input: those columns and rows with the kernel's reach around them
             const int xi = std::max(0, xa - kReach), xj = std::min(small.cols, xb + kReach);
             cv::Mat md_ext;
-            cv::dilate(motion(cv::Range(ya, yb), cv::Range(xi, xj)), md_ext, kern);
+            dilate_ellipse(motion(cv::Range(ya, yb), cv::Range(xi, xj)), md_ext, kReach);
             md = md_ext(cv::Range(y0 - ya, y1 - ya), cv::Range(xa - xi, xb - xi));
             cv::Rect r(xa, y0, xb - xa, y1 - y0);
             cv::cvtColor(small(r), hsv, cv::COLOR_BGR2HSV);

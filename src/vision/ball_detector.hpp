@@ -95,6 +95,10 @@ private:
 // |img - background rounded to whole levels| (img CV_8UC3, bg CV_32FC3 of its size).
 void max_channel_diff(const cv::Mat &img, const cv::Mat &bg, cv::Mat &out);
 
+// cv::dilate(src, dst, MORPH_ELLIPSE of size 2r+1), the same pixels, by runs
+// (src CV_8UC1; what lies outside src, even of a parent matrix, counts as empty).
+void dilate_ellipse(const cv::Mat &src, cv::Mat &dst, int r);
+
 }  // namespace gs
 
 #endif
