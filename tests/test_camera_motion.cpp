@@ -252,6 +252,64 @@ static void test_area_reduction_is_opencvs(void)
     TEST_ASSERT_EQUAL_INT(cases, same);
 }
 
+// the corner search gives OpenCV's corners in OpenCV's order: whole frames, cells
+// of a frame (the gradient reads past a cell's edge), masks, both block sizes
+static void test_corners_are_opencvs(void)
+{
+    std::vector<cv::Mat> greys;
+    char p_buf[512];
+    std::snprintf(p_buf, sizeof p_buf, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    if (exists(p_buf)) {
+        cv::VideoCapture cap(p_buf);
+        cv::Mat f, g;
+        for (int i = 0; cap.read(f); i++) {
+            if (i % 6) continue;
+            cv::cvtColor(f, g, cv::COLOR_BGR2GRAY);
+            cv::resize(g, g, cv::Size(), 640.0 / g.cols, 640.0 / g.cols, cv::INTER_AREA);
+            greys.push_back(g.clone());
+        }
+    }
+    cv::RNG rng(11);
+    for (int i = 0; i < 4; i++) {  // noise: many equal eigenvalues, ties broken by position
+        cv::Mat g(rng.uniform(40, 300), rng.uniform(40, 300), CV_8UC1);
+        rng.fill(g, cv::RNG::UNIFORM, 0, i % 2 ? 4 : 256);
+        greys.push_back(g);
+    }
+    gs::CornerWork work;
+    int cases = 0, same = 0, corners = 0;
+    for (const cv::Mat &g : greys) {
+        for (int trial = 0; trial < 4; trial++) {
+            cv::Mat img = g, mask;
+            if (trial >= 1) {  // a cell inside the frame
+                int x = rng.uniform(0, g.cols / 2), y = rng.uniform(0, g.rows / 2);
+                img = g(cv::Rect(x, y, rng.uniform(16, g.cols - x), rng.uniform(16, g.rows - y)));
+            }
+            if (trial >= 2) {
+                mask.create(img.size(), CV_8U);
+                mask.setTo(255);
+                cv::circle(mask, cv::Point(img.cols / 2, img.rows / 2), img.cols / 4, cv::Scalar(0), -1);
+            }
+            if (trial == 3) {
+                mask.setTo(0);
+                cv::rectangle(mask, cv::Rect(2, 2, img.cols / 3, img.rows / 3), cv::Scalar(255), -1);
+            }
+            for (int block : {3, 5})
+                for (double spacing : {12.0, 3.0, 0.0})
+                    for (int most : {9, 60, 0}) {
+                        std::vector<cv::Point2f> a, b;
+                        cv::goodFeaturesToTrack(img, a, most, 0.01, spacing, mask, block);
+                        gs::good_features(img, b, most, 0.01, spacing, mask, block, work);
+                        cases++;
+                        corners += (int)a.size();
+                        same += a == b;
+                    }
+        }
+    }
+    std::printf("corners: %d of %d searches as cv::goodFeaturesToTrack (%d corners)\n", same, cases, corners);
+    TEST_ASSERT_TRUE(cases >= 18 * 4 * 4);
+    TEST_ASSERT_EQUAL_INT(cases, same);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -261,5 +319,6 @@ int main(void)
     RUN_TEST(test_real_static_camera);
     RUN_TEST(test_real_handheld_camera);
     RUN_TEST(test_area_reduction_is_opencvs);
+    RUN_TEST(test_corners_are_opencvs);
     return UNITY_END();
 }

@@ -9,6 +9,9 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -195,6 +198,272 @@ void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
     dst = out;
 }
 
+namespace {
+
+#if defined(__SSE2__) && !defined(__FMA__)
+constexpr bool kExactEigen = true;  // no fused multiply-add: the floats round as OpenCV's do
+#else
+constexpr bool kExactEigen = false;
+#endif
+
+inline int reflect101(int i, int n)
+{
+    if (n == 1) return 0;
+    while (i < 0 || i >= n) i = i < 0 ? -i : 2 * n - 2 - i;
+    return i;
+}
+
+// the box's row sums of one row of products, in double, in OpenCV's order (RowSum)
+void box_row_scalar(const float *S, int w, int block, double *D)
+{
+    if (block == 3)
+        for (int i = 0; i < w; i++) D[i] = (double)S[i] + (double)S[i + 1] + (double)S[i + 2];
+    else
+        for (int i = 0; i < w; i++)
+            D[i] = (double)S[i] + (double)S[i + 1] + (double)S[i + 2] + (double)S[i + 3] + (double)S[i + 4];
+}
+
+void products_scalar(const float *X, const float *Y, int w, float *A, float *B, float *C)
+{
+    for (int x = 0; x < w; x++) {
+        const float gx = X[x], gy = Y[x];
+        A[x] = gx * gx;
+        B[x] = gx * gy;
+        C[x] = gy * gy;
+    }
+}
+
+// one output row: the column's running sums (ColumnSum) and the smaller eigenvalue (calcMinEigenVal)
+void column_eigen_scalar(double *sum, const double *P, const double *M, int w, float *E)
+{
+    double *sa = sum, *sb = sum + w, *sc = sum + 2 * w;
+    const double *pa = P, *pb = P + w, *pc = P + 2 * w, *ma = M, *mb = M + w, *mc = M + 2 * w;
+    for (int i = 0; i < w; i++) {
+        const double s0a = sa[i] + pa[i], s0b = sb[i] + pb[i], s0c = sc[i] + pc[i];
+        const float a = (float)s0a * 0.5f, b = (float)s0b, c = (float)s0c * 0.5f;
+        sa[i] = s0a - ma[i];
+        sb[i] = s0b - mb[i];
+        sc[i] = s0c - mc[i];
+        const float t = a - c;
+        E[i] = (a + c) - std::sqrt(t * t + b * b);
+    }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GS_EIGEN_AVX2 1
+// the same sums, 4 doubles at a time (no FMA: every product and sum rounds as above)
+__attribute__((target("avx2"))) void box_row_avx2(const float *S, int w, int block, double *D)
+{
+    int i = 0;
+    for (; i + 4 <= w; i += 4) {
+        __m256d v = _mm256_add_pd(_mm256_cvtps_pd(_mm_loadu_ps(S + i)), _mm256_cvtps_pd(_mm_loadu_ps(S + i + 1)));
+        v = _mm256_add_pd(v, _mm256_cvtps_pd(_mm_loadu_ps(S + i + 2)));
+        if (block == 5) {
+            v = _mm256_add_pd(v, _mm256_cvtps_pd(_mm_loadu_ps(S + i + 3)));
+            v = _mm256_add_pd(v, _mm256_cvtps_pd(_mm_loadu_ps(S + i + 4)));
+        }
+        _mm256_storeu_pd(D + i, v);
+    }
+    if (i < w) box_row_scalar(S + i, w - i, block, D + i);
+}
+
+__attribute__((target("avx2"))) void products_avx2(const float *X, const float *Y, int w, float *A, float *B, float *C)
+{
+    int x = 0;
+    for (; x + 8 <= w; x += 8) {
+        const __m256 gx = _mm256_loadu_ps(X + x), gy = _mm256_loadu_ps(Y + x);
+        _mm256_storeu_ps(A + x, _mm256_mul_ps(gx, gx));
+        _mm256_storeu_ps(B + x, _mm256_mul_ps(gx, gy));
+        _mm256_storeu_ps(C + x, _mm256_mul_ps(gy, gy));
+    }
+    if (x < w) products_scalar(X + x, Y + x, w - x, A + x, B + x, C + x);
+}
+
+__attribute__((target("avx2"))) void column_eigen_avx2(double *sum, const double *P, const double *M, int w, float *E)
+{
+    double *sa = sum, *sb = sum + w, *sc = sum + 2 * w;
+    const double *pa = P, *pb = P + w, *pc = P + 2 * w, *ma = M, *mb = M + w, *mc = M + 2 * w;
+    const __m128 half = _mm_set1_ps(0.5f);
+    int i = 0;
+    for (; i + 4 <= w; i += 4) {
+        const __m256d s0a = _mm256_add_pd(_mm256_loadu_pd(sa + i), _mm256_loadu_pd(pa + i));
+        const __m256d s0b = _mm256_add_pd(_mm256_loadu_pd(sb + i), _mm256_loadu_pd(pb + i));
+        const __m256d s0c = _mm256_add_pd(_mm256_loadu_pd(sc + i), _mm256_loadu_pd(pc + i));
+        _mm256_storeu_pd(sa + i, _mm256_sub_pd(s0a, _mm256_loadu_pd(ma + i)));
+        _mm256_storeu_pd(sb + i, _mm256_sub_pd(s0b, _mm256_loadu_pd(mb + i)));
+        _mm256_storeu_pd(sc + i, _mm256_sub_pd(s0c, _mm256_loadu_pd(mc + i)));
+        const __m128 a = _mm_mul_ps(_mm256_cvtpd_ps(s0a), half), b = _mm256_cvtpd_ps(s0b);
+        const __m128 c = _mm_mul_ps(_mm256_cvtpd_ps(s0c), half), t = _mm_sub_ps(a, c);
+        const __m128 q = _mm_add_ps(_mm_mul_ps(t, t), _mm_mul_ps(b, b));
+        _mm_storeu_ps(E + i, _mm_sub_ps(_mm_add_ps(a, c), _mm_sqrt_ps(q)));
+    }
+    if (i < w) {
+        // the tail's running sums live at the same offsets of the three planes
+        for (; i < w; i++) {
+            const double s0a = sa[i] + pa[i], s0b = sb[i] + pb[i], s0c = sc[i] + pc[i];
+            const float a = (float)s0a * 0.5f, b = (float)s0b, c = (float)s0c * 0.5f;
+            sa[i] = s0a - ma[i];
+            sb[i] = s0b - mb[i];
+            sc[i] = s0c - mc[i];
+            const float t = a - c;
+            E[i] = (a + c) - std::sqrt(t * t + b * b);
+        }
+    }
+}
+
+bool have_avx2()
+{
+    static const bool yes = __builtin_cpu_supports("avx2");
+    return yes;
+}
+#endif
+
+// cv::cornerMinEigenVal(src, eig, block, 3, BORDER_DEFAULT) with the same floats:
+// OpenCV's Sobel, then the products' unnormalised box sums (double, BORDER_REFLECT_101)
+// and the smaller eigenvalue of each 2x2 sum
+void min_eigen(const cv::Mat &src, int block, CornerWork &wk)
+{
+    const double scale = 1.0 / ((1 << 2) * block * 255.0);
+    cv::Sobel(src, wk.dx, CV_32F, 1, 0, 3, scale, 0, cv::BORDER_DEFAULT);
+    cv::Sobel(src, wk.dy, CV_32F, 0, 1, 3, scale, 0, cv::BORDER_DEFAULT);
+    const int w = src.cols, h = src.rows, r = block / 2, bw = w + 2 * r;
+    wk.eig.create(h, w, CV_32F);
+    // the running sums (3 planes of w), block rows of row sums (3 planes each), one bordered row of products
+    const size_t plane = static_cast<size_t>(w);
+    wk.box.resize(3 * plane * (block + 1) + (3 * static_cast<size_t>(bw) + 1) / 2 + 1);
+    double *sum = wk.box.data();
+    double *rows = sum + 3 * plane;
+    float *prod = reinterpret_cast<float *>(rows + 3 * plane * block);
+    float *A = prod, *B = prod + bw, *C = prod + 2 * bw;
+#ifdef GS_EIGEN_AVX2
+    const bool avx2 = have_avx2();
+#endif
+    auto row_sums = [&](int j, double *out) {  // bordered row j, -r .. h - 1 + r
+        const int y = reflect101(j, h);
+        const float *X = wk.dx.ptr<float>(y), *Y = wk.dy.ptr<float>(y);
+#ifdef GS_EIGEN_AVX2
+        if (avx2)
+            products_avx2(X, Y, w, A + r, B + r, C + r);
+        else
+#endif
+            products_scalar(X, Y, w, A + r, B + r, C + r);
+        for (int k = 1; k <= r; k++) {  // BORDER_REFLECT_101 across
+            const int lx = reflect101(-k, w) + r, rx = reflect101(w - 1 + k, w) + r;
+            A[r - k] = A[lx], B[r - k] = B[lx], C[r - k] = C[lx];
+            A[w - 1 + k + r] = A[rx], B[w - 1 + k + r] = B[rx], C[w - 1 + k + r] = C[rx];
+        }
+        for (int ch = 0; ch < 3; ch++) {
+#ifdef GS_EIGEN_AVX2
+            if (avx2) {
+                box_row_avx2(prod + ch * bw, w, block, out + ch * plane);
+                continue;
+            }
+#endif
+            box_row_scalar(prod + ch * bw, w, block, out + ch * plane);
+        }
+    };
+    auto slot = [&](int j) { return rows + 3 * plane * static_cast<size_t>((j + r) % block); };
+    std::fill(sum, sum + 3 * plane, 0.0);
+    for (int j = -r; j < r; j++) {  // the first block - 1 rows
+        double *R = slot(j);
+        row_sums(j, R);
+        for (size_t i = 0; i < 3 * plane; i++) sum[i] += R[i];
+    }
+    for (int y = 0; y < h; y++) {
+        double *P = slot(y + r);
+        row_sums(y + r, P);
+        const double *M = slot(y - r);  // another slot than P's: the block holds 2r + 1 rows
+        float *E = wk.eig.ptr<float>(y);
+#ifdef GS_EIGEN_AVX2
+        if (avx2) {
+            column_eigen_avx2(sum, P, M, w, E);
+            continue;
+        }
+#endif
+        column_eigen_scalar(sum, P, M, w, E);
+    }
+}
+
+}  // namespace
+
+void good_features(const cv::Mat &img, std::vector<cv::Point2f> &corners, int max_corners, double quality,
+                   double min_distance, const cv::Mat &mask, int block, CornerWork &wk)
+{
+    if (!kExactEigen || (block != 3 && block != 5) || img.type() != CV_8UC1 || img.rows < 2 || img.cols < 2) {
+        cv::goodFeaturesToTrack(img, corners, max_corners, quality, min_distance, mask, block);
+        return;
+    }
+    corners.clear();
+    min_eigen(img, block, wk);
+    const cv::Mat &eig = wk.eig;
+    double max_val = 0.0;
+    cv::minMaxLoc(eig, nullptr, &max_val, nullptr, nullptr, mask);
+    const float thr = static_cast<float>(max_val * quality);
+    const int w = img.cols, h = img.rows;
+    // local maxima of the image thresholded to zero (cv::threshold, cv::dilate 3x3), inside the border
+    std::vector<const float *> &cand = wk.cand;
+    cand.clear();
+    auto kept = [thr](float v) { return v > thr ? v : 0.0f; };
+    for (int y = 1; y < h - 1; y++) {
+        const float *E0 = eig.ptr<float>(y - 1), *E1 = eig.ptr<float>(y), *E2 = eig.ptr<float>(y + 1);
+        const uchar *M = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+        for (int x = 1; x < w - 1; x++) {
+            const float v = E1[x];
+            if (!(v > thr) || v == 0.0f || (M && !M[x])) continue;
+            float m = v;
+            for (int k = -1; k <= 1; k++)
+                m = std::max(m, std::max(kept(E0[x + k]), std::max(kept(E1[x + k]), kept(E2[x + k]))));
+            if (v == m) cand.push_back(E1 + x);
+        }
+    }
+    if (cand.empty()) return;
+    // OpenCV's order (greaterThanPtr): the larger value first, of equal values the later address
+    auto below = [](const float *a, const float *b) { return *a < *b || (*a == *b && a < b); };
+    std::make_heap(cand.begin(), cand.end(), below);
+    size_t left = cand.size();
+    auto next = [&](int *x, int *y) {
+        std::pop_heap(cand.begin(), cand.begin() + left, below);
+        const size_t ofs = static_cast<size_t>(reinterpret_cast<const uchar *>(cand[--left]) - eig.ptr());
+        *y = static_cast<int>(ofs / eig.step);
+        *x = static_cast<int>((ofs - *y * eig.step) / sizeof(float));
+    };
+    if (min_distance < 1) {
+        while (left > 0 && (max_corners <= 0 || (int)corners.size() < max_corners)) {
+            int x, y;
+            next(&x, &y);
+            corners.push_back(cv::Point2f((float)x, (float)y));
+        }
+        return;
+    }
+    const int cell = cvRound(min_distance);
+    const int gw = (w + cell - 1) / cell, gh = (h + cell - 1) / cell;
+    std::vector<std::vector<cv::Point2f>> &grid = wk.grid;
+    if (grid.size() < static_cast<size_t>(gw) * gh) grid.resize(static_cast<size_t>(gw) * gh);
+    const double md2 = min_distance * min_distance;
+    while (left > 0) {
+        int x, y;
+        next(&x, &y);
+        const int xc = x / cell, yc = y / cell;
+        const int x1 = std::max(0, xc - 1), y1 = std::max(0, yc - 1);
+        const int x2 = std::min(gw - 1, xc + 1), y2 = std::min(gh - 1, yc + 1);
+        bool good = true;
+        for (int yy = y1; yy <= y2 && good; yy++)
+            for (int xx = x1; xx <= x2 && good; xx++)
+                for (const cv::Point2f &q : grid[static_cast<size_t>(yy) * gw + xx]) {
+                    const float ddx = x - q.x, ddy = y - q.y;
+                    if (ddx * ddx + ddy * ddy < md2) {
+                        good = false;
+                        break;
+                    }
+                }
+        if (!good) continue;
+        grid[static_cast<size_t>(yc) * gw + xc].push_back(cv::Point2f((float)x, (float)y));
+        corners.push_back(cv::Point2f((float)x, (float)y));
+        if (max_corners > 0 && (int)corners.size() == max_corners) break;
+    }
+    for (const cv::Point2f &p : corners) grid[static_cast<size_t>(static_cast<int>(p.y) / cell) * gw + static_cast<int>(p.x) / cell].clear();
+}
+
 CameraMotion::CameraMotion(const CameraMotionConfig &cfg) : cfg_(cfg), cur_from_ref_(1, 0, 0, 0, 1, 0) {}
 
 void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &exclude, CameraMotionFrame *out)
@@ -304,7 +573,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
                 cv::Rect cell(gx * cur.cols / grid, gy * cur.rows / grid, cur.cols / grid, cur.rows / grid);
                 if (cv::countNonZero(mask(cell)) == 0) continue;  // all covered: no corner can come of it
                 std::vector<cv::Point2f> fresh;
-                cv::goodFeaturesToTrack(cur(cell), fresh, want, 0.01, cfg_.min_spacing_px, mask(cell), 5);
+                good_features(cur(cell), fresh, want, 0.01, cfg_.min_spacing_px, mask(cell), 5, corner_work_);
                 for (cv::Point2f &p : fresh) pts_.push_back(p + cv::Point2f((float)cell.x, (float)cell.y));
             }
     }
@@ -341,7 +610,7 @@ int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vecto
     cv::resize(prev(box), half, cv::Size(box.width / 2, box.height / 2), 0, 0, cv::INTER_AREA);
     cv::resize(mask(box), half_mask, half.size(), 0, 0, cv::INTER_NEAREST);
     std::vector<cv::Point2f> p0, p1;
-    cv::goodFeaturesToTrack(half, p0, cfg_.ring_features, 0.01, 0.25 * cfg_.min_spacing_px, half_mask, 3);
+    good_features(half, p0, cfg_.ring_features, 0.01, 0.25 * cfg_.min_spacing_px, half_mask, 3, corner_work_);
     if (p0.empty()) return 0;
     for (cv::Point2f &p : p0) p = cv::Point2f(2.0f * p.x + 0.5f + (float)box.x, 2.0f * p.y + 0.5f + (float)box.y);
     std::vector<uchar> st;

@@ -42,6 +42,22 @@ struct CameraMotionFrame {
 // a non-integer reduction (720 -> 640 px) cost several times a whole-factor one.
 void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f);
 
+// Scratch memory of good_features, kept from call to call.
+struct CornerWork {
+    cv::Mat dx, dy, eig;
+    std::vector<double> box;
+    std::vector<const float *> cand;
+    std::vector<std::vector<cv::Point2f>> grid;
+};
+
+// cv::goodFeaturesToTrack(img, corners, max_corners, quality, min_distance, mask,
+// block) (minimum eigenvalue, gradient 3, block 3 or 5) with the same corners in
+// the same order: the eigenvalues' box sums in double in OpenCV's order (AVX2
+// when the CPU has it), the candidates taken best first from a heap instead of
+// all sorted.
+void good_features(const cv::Mat &img, std::vector<cv::Point2f> &corners, int max_corners, double quality,
+                   double min_distance, const cv::Mat &mask, int block, CornerWork &work);
+
 class CameraMotion {
 public:
     explicit CameraMotion(const CameraMotionConfig &cfg = CameraMotionConfig());
@@ -58,6 +74,7 @@ private:
     std::vector<cv::Mat> spare_pyr_; // the one before, whose memory the next pyramid takes
     cv::Mat grey_, cur_, mask_;     // this frame's grey, working image and corner mask
     mutable cv::Mat ring_mask_;     // other_motion's ring
+    mutable CornerWork corner_work_;
     std::vector<cv::Point2f> pts_; // corners in prev_
     cv::Matx23d cur_from_ref_;     // full-frame pixels: reference -> current
     bool have_ = false;
