@@ -508,14 +508,18 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
 
     bool matched = false;
     if (have_ && !pts_.empty()) {
-        std::vector<cv::Point2f> next;
+        // a corner inside a subject's region is left out whatever its flow, so it is
+        // not followed (Lucas-Kanade follows each point on its own)
+        std::vector<cv::Point2f> from, next;
+        for (const cv::Point2f &p : pts_)
+            if (!inside_any(ex, p)) from.push_back(p);
         std::vector<uchar> st;
         std::vector<float> err;
-        cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, pts_, next, st, err, win, levels);
+        if (!from.empty()) cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, from, next, st, err, win, levels);
         std::vector<cv::Point2f> a, b;
-        for (size_t i = 0; i < pts_.size(); i++)
-            if (st[i] && !inside_any(ex, next[i]) && !inside_any(ex, pts_[i])) {
-                a.push_back(pts_[i]);
+        for (size_t i = 0; i < from.size(); i++)
+            if (st[i] && !inside_any(ex, next[i])) {
+                a.push_back(from[i]);
                 b.push_back(next[i]);
             }
         if ((int)a.size() >= cfg_.min_inliers) {
