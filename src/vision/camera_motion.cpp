@@ -318,6 +318,33 @@ bool have_avx2()
 }
 #endif
 
+// the x in [x0, x1) where E[x] > thr and E[x] != 0 (a corner's first test), into xs; their count
+int above_scalar(const float *E, int x0, int x1, float thr, int *xs)
+{
+    int n = 0;
+    for (int x = x0; x < x1; x++)
+        if (E[x] > thr && E[x] != 0.0f) xs[n++] = x;
+    return n;
+}
+
+#ifdef GS_EIGEN_AVX2
+__attribute__((target("avx2"))) int above_avx2(const float *E, int x0, int x1, float thr, int *xs)
+{
+    const __m256 t = _mm256_set1_ps(thr), z = _mm256_setzero_ps();
+    int n = 0, x = x0;
+    for (; x + 8 <= x1; x += 8) {
+        const __m256 v = _mm256_loadu_ps(E + x);
+        unsigned bits = static_cast<unsigned>(_mm256_movemask_ps(
+            _mm256_and_ps(_mm256_cmp_ps(v, t, _CMP_GT_OQ), _mm256_cmp_ps(v, z, _CMP_NEQ_OQ))));
+        while (bits) {
+            xs[n++] = x + __builtin_ctz(bits);
+            bits &= bits - 1;
+        }
+    }
+    return n + above_scalar(E, x, x1, thr, xs + n);
+}
+#endif
+
 // cv::cornerMinEigenVal(src, eig, block, 3, BORDER_DEFAULT) with the same floats:
 // OpenCV's Sobel, then the products' unnormalised box sums (double, BORDER_REFLECT_101)
 // and the smaller eigenvalue of each 2x2 sum
@@ -404,12 +431,21 @@ void good_features(const cv::Mat &img, std::vector<cv::Point2f> &corners, int ma
     std::vector<const float *> &cand = wk.cand;
     cand.clear();
     auto kept = [thr](float v) { return v > thr ? v : 0.0f; };
+    wk.xs.resize(static_cast<size_t>(w));
     for (int y = 1; y < h - 1; y++) {
         const float *E0 = eig.ptr<float>(y - 1), *E1 = eig.ptr<float>(y), *E2 = eig.ptr<float>(y + 1);
         const uchar *M = mask.empty() ? nullptr : mask.ptr<uchar>(y);
-        for (int x = 1; x < w - 1; x++) {
+        int n;
+#ifdef GS_EIGEN_AVX2
+        if (have_avx2())
+            n = above_avx2(E1, 1, w - 1, thr, wk.xs.data());
+        else
+#endif
+            n = above_scalar(E1, 1, w - 1, thr, wk.xs.data());
+        for (int i = 0; i < n; i++) {
+            const int x = wk.xs[i];
             const float v = E1[x];
-            if (!(v > thr) || v == 0.0f || (M && !M[x])) continue;
+            if (M && !M[x]) continue;
             float m = v;
             for (int k = -1; k <= 1; k++)
                 m = std::max(m, std::max(kept(E0[x + k]), std::max(kept(E1[x + k]), kept(E2[x + k]))));

@@ -47,6 +47,7 @@ struct CornerWork {
     cv::Mat dx, dy, eig;
     std::vector<double> box;
     std::vector<const float *> cand;
+    std::vector<int> xs;
     std::vector<std::vector<cv::Point2f>> grid;
 };
 
