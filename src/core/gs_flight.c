@@ -699,6 +699,62 @@ static gs_real pw_ssr_solve(gs_real A[4][4], gs_real b[4], gs_real yy, gs_real c
     return ssr_left(yy3, c, b3, 3);
 }
 
+#ifndef __OPTIMIZE_SIZE__
+/* Hosts: solve_spd in two steps, so that the leading 3 x 3 rows of the factor, which the
+ * boundary's grid points share, are taken once (the same arithmetic in the same order). */
+/* Rows [i0, k) of the Cholesky factor L of the k x k (k <= 4) symmetric A; false if not PD. */
+static bool chol_rows(gs_real A[4][4], gs_real L[4][4], int i0, int k)
+{
+    const gs_real tiny = sizeof(gs_real) < sizeof(double) ? GS_R(1e-6) : GS_R(1e-12);  /* as solve_spd */
+    for (int i = i0; i < k; i++) {
+        for (int j = 0; j <= i; j++) {
+            gs_real s = A[i][j];
+            for (int m = 0; m < j; m++) s -= L[i][m] * L[j][m];
+            if (i == j) {
+                if (!(s > tiny * (A[i][i] > 0 ? A[i][i] : GS_R(1.0)))) return false;
+                L[i][i] = GS_SQRT(s);
+            } else {
+                L[i][j] = s / L[j][j];
+            }
+        }
+    }
+    return true;
+}
+
+/* Solve L L^T c = b for the k x k factor L (solve_spd's substitutions). */
+static void chol_solve(gs_real L[4][4], const gs_real b[4], int k, gs_real c[4])
+{
+    gs_real y[4];
+    for (int i = 0; i < k; i++) {
+        gs_real s = b[i];
+        for (int m = 0; m < i; m++) s -= L[i][m] * y[m];
+        y[i] = s / L[i][i];
+    }
+    for (int i = k - 1; i >= 0; i--) {
+        gs_real s = y[i];
+        for (int m = i + 1; m < k; m++) s -= L[m][i] * c[m];
+        c[i] = s / L[i][i];
+    }
+}
+
+/* pw_ssr_solve with L's first three rows given (l3: A's leading 3 x 3 is PD) */
+static gs_real pw_ssr_solve_l3(gs_real A[4][4], gs_real b[4], gs_real yy, gs_real c3_min, gs_real c3_max,
+                               gs_real L[4][4], bool l3)
+{
+    gs_real c[4];
+    bool solved = A[3][3] > GS_R(0.0) && l3 && chol_rows(A, L, 3, 4);
+    if (solved) chol_solve(L, b, 4, c);
+    if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
+    gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
+    gs_real b3[4];
+    for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
+    gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
+    if (!l3) return INFINITY;
+    chol_solve(L, b3, 3, c);
+    return ssr_left(yy3, c, b3, 3);
+}
+#endif
+
 /* Weighted SSR of u over samples [lo, hi] under parabola + alpha/2 (T - t)^2 for t < T
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
@@ -750,6 +806,8 @@ typedef struct {
 typedef struct {
     gs_real A[3][3], b[3], yy, ts2;
     uint32_t n;
+    bool l3;
+    gs_real L[4][4];  /* rows 0-2: the Cholesky factor of A, when l3 (row 3: each grid point's) */
     pw_sample s[PW_CACHE];
 } pw_sums;
 
@@ -758,7 +816,7 @@ typedef struct {
 static bool pw_prepare(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_lo, int64_t t_hi,
                        int64_t T_reach, int side, const gs_fit_result *r, pw_sums *P)
 {
-    memset(P, 0, offsetof(pw_sums, s));
+    memset(P, 0, offsetof(pw_sums, L));
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
     gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
@@ -787,11 +845,15 @@ static bool pw_prepare(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_l
             c->u = u;
         }
     }
+    gs_real A4[4][4] = {{0}};
+    for (int k = 0; k < 3; k++)
+        for (int m = 0; m < 3; m++) A4[k][m] = P->A[k][m];
+    P->l3 = chol_rows(A4, P->L, 0, 3);
     return true;
 }
 
 /* piecewise_ssr at T from the prepared sums */
-static gs_real pw_ssr_at(const pw_sums *P, int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
+static gs_real pw_ssr_at(pw_sums *P, int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
 {
     gs_real A[4][4] = {{0}}, b[4] = {0};
     for (int k = 0; k < 3; k++) {
@@ -811,7 +873,7 @@ static gs_real pw_ssr_at(const pw_sums *P, int64_t T, int side, gs_real alpha_mi
         }
         A[3][3] += w * h * h;
     }
-    return pw_ssr_solve(A, b, P->yy, alpha_min_px * P->ts2, alpha_max_px * P->ts2);
+    return pw_ssr_solve_l3(A, b, P->yy, alpha_min_px * P->ts2, alpha_max_px * P->ts2, P->L, P->l3);
 }
 #endif
 
