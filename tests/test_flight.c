@@ -125,6 +125,8 @@ static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(doub
 
 static gs_jump_judge_fn g_judge; /* the front end's judge for run_from (NULL: none) */
 static int64_t g_clock_us;       /* run_from's clock: sample time t is g_clock_us + t, in microseconds */
+static uint64_t g_ring_head;     /* run_from: the ring's absolute index of the first sample (0: as initialised) */
+static uint32_t g_rebase_after;  /* ... and the flight's index base moves after this many samples */
 static void run_from(const sim_track *s, const cam *c, capture *cap, double t_begin, double t_end);
 static void run(const sim_track *s, const cam *c, capture *cap, double t_end) { run_from(s, c, cap, 0.0, t_end); }
 
@@ -138,6 +140,12 @@ static void run_from(const sim_track *s, const cam *c, capture *cap, double t_be
     memset(cap, 0, sizeof *cap);
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, GS_LAYOUT_POINT, storage, sizeof storage, on_event, cap));
     gs_pipeline_set_judge(&p, g_judge, cap);
+    if (g_ring_head) {  /* as after a stream of g_ring_head samples, the flight's base due to move */
+        p.ring.head = p.ring.valid_from = g_ring_head;
+        uint32_t off = 2u * GS_FLIGHT_IDX_KEEP - g_rebase_after;
+        p.flight.base = g_ring_head - off;
+        p.flight.next = p.flight.quiet_from = off;
+    }
     double ca = cos(c->roll_deg * PI / 180.0), sa = sin(c->roll_deg * PI / 180.0);
     double size_px = c->size_m / c->q_m_per_px;
     for (long i = (long)ceil(t_begin * c->fps);; i++) {
@@ -413,6 +421,40 @@ static void test_hours_across_time_wraps(void)
     }
 }
 
+/* The flight's 32-bit sample indices are offsets from a base that moves every 2^30
+ * samples: moved at any sample of a noisy stream (inside flights too), with ring indices
+ * beyond 32 bits, the events are the same to the bit. */
+static void test_index_base_moves(void)
+{
+    sim_track s;
+    make_track(&s, 2, 1.5, 2.0, 2.0, 2.6);
+    cam c = {60.0, 0.003, 3.0, 0.6, 0.20, 0.02, 0.37};
+    static capture cap_ref, cap;
+    rng_state = 0x9E3779B97F4A7C15ull;
+    run(&s, &c, &cap_ref, 6.0);
+    int map[MAX_JUMPS];
+    TEST_ASSERT_EQUAL_INT(2, match(&s, &cap_ref, map));
+    for (uint32_t after = 1; after < 360; after += 7) {
+        g_ring_head = 0x100000000ull + 12345u;
+        g_rebase_after = after;
+        rng_state = 0x9E3779B97F4A7C15ull;
+        run(&s, &c, &cap, 6.0);
+        g_ring_head = 0;
+        TEST_ASSERT_EQUAL_INT(cap_ref.n_jumps, cap.n_jumps);
+        for (int e = 0; e < cap.n_jumps; e++) {
+            const gs_ev_jump *j = &cap.jumps[e], *r = &cap_ref.jumps[e];
+            TEST_ASSERT_EQUAL_INT64(r->t_takeoff_us, j->t_takeoff_us);
+            TEST_ASSERT_EQUAL_INT64(r->t_land_us, j->t_land_us);
+            TEST_ASSERT_EQUAL_MEMORY(&r->a_px_s2, &j->a_px_s2, sizeof j->a_px_s2);
+            TEST_ASSERT_EQUAL_MEMORY(&r->height_m, &j->height_m, sizeof j->height_m);
+            TEST_ASSERT_EQUAL_UINT32(r->n_samples, j->n_samples);
+            TEST_ASSERT_EQUAL_UINT32(r->n_outliers, j->n_outliers);
+            TEST_ASSERT_EQUAL(r->accepted, j->accepted);
+            TEST_ASSERT_EQUAL_INT(r->reason, j->reason);
+        }
+    }
+}
+
 /* A pause longer than the ring's time span (35.8 min) in the middle of a
  * flight: the flight closes on what was seen, as on a pause within the span
  * (10 s, also a gap that ends the flight), and later jumps are found as then. */
@@ -534,6 +576,7 @@ int main(void)
     RUN_TEST(test_time_gaps);
     RUN_TEST(test_ring_smaller_than_a_flight);
     RUN_TEST(test_hours_across_time_wraps);
+    RUN_TEST(test_index_base_moves);
     RUN_TEST(test_pause_beyond_time_span);
     RUN_TEST(test_clock_offset_invariance);
     RUN_TEST(test_bad_calls);

@@ -21,6 +21,14 @@ const char *gs_flight_state_name(gs_flight_state s);
 
 #define GS_STAND_KEEP 32  /* standing size samples kept for the size estimate */
 
+/* The flight's sample indices are 32-bit offsets from a 64-bit base, which moves up once
+ * the ring's head is twice this past it (the ring must hold fewer samples than this).
+ * GS_NO_IDX: no sample. */
+#ifndef GS_FLIGHT_IDX_KEEP
+#define GS_FLIGHT_IDX_KEEP (1u << 30)
+#endif
+#define GS_NO_IDX UINT32_MAX
+
 typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 
 typedef struct {
@@ -37,10 +45,11 @@ typedef struct {
     int64_t min_flight_us, max_flight_us, max_gap_us, landing_latency_us;
 
     gs_flight_state state;
-    uint64_t next;             /* next ring index to examine */
-    uint64_t quiet_from;       /* first index after the last closed candidate */
+    uint64_t base;             /* ring index of offset 0: the indices below are offsets from it */
+    uint32_t next;             /* next index to examine */
+    uint32_t quiet_from;       /* first index after the last closed candidate */
     int64_t last_t_us;         /* time of the last valid sample, GS_T_NONE none */
-    uint64_t last_idx;
+    uint32_t last_idx;
 
     gs_real up_x, up_y;        /* image direction against gravity (unit) */
     uint32_t up_n;             /* body-axis samples averaged into it */
@@ -50,20 +59,20 @@ typedef struct {
     float noise_init[9];       /* first |second differences| (NOISE_INIT_N) */
     uint32_t noise_n;
     gs_real u_hist[3];         /* last three u of valid samples (for a median of 3) */
-    uint64_t i_hist[3];
+    uint32_t i_hist[3];
     int64_t t_hist_us[3];
     uint32_t n_hist;
 
     gs_real blk_min_cur, blk_min_prev; /* running minimum of u over the last ~0.5-1 s */
     int64_t blk_t0_us;
     gs_real peak_u;            /* running maximum once the rise is significant */
-    uint64_t peak_idx;
+    uint32_t peak_idx;
     int64_t peak_t_us;
 
     /* the open flight candidate */
     gs_fit fit;                /* streaming fit of the accepted in-flight samples */
-    uint64_t fl_first, fl_last;   /* accepted range so far (absolute ring indices) */
-    uint64_t seed_idx;
+    uint32_t fl_first, fl_last;   /* accepted range so far */
+    uint32_t seed_idx;
     gs_real cusum;             /* one-sided CUSUM of the deviation against gravity */
     uint32_t pend_ok;          /* bit k: pending sample fl_last+1+k is no gross outlier */
     uint32_t outliers_run;     /* consecutive gross outliers */
@@ -87,7 +96,7 @@ typedef struct {
     uint16_t stand_floor_epoch;/* ... measured in this epoch of the feet's direction */
     int64_t last_land_us;      /* the latest landing (of a jump or a fall), GS_T_NONE none */
     int64_t feet_wait_us;      /* the COM landed: wait until then for the feet, GS_T_NONE not waiting */
-    uint64_t wait_alarm;       /* ... the contact alarm it landed with */
+    uint32_t wait_alarm;       /* ... the contact alarm it landed with */
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,

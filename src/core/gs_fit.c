@@ -222,6 +222,34 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     return GS_OK;
 }
 
+#if GS_FIT_FAST
+/* solve_par's verdict and parabola without the result's fields (an IRLS step needs only
+ * the curve): the same checks and the same arithmetic */
+static gs_status solve_par_only(const gs_fit *f, gs_par *p, const gs_par *base)
+{
+    gs_real col[3];
+    int k;
+    if (f->n < 3) {
+        return GS_EINVAL;
+    }
+    col[0] = fabs(f->r[0]);
+    col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
+    col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
+    for (k = 0; k < 3; k++) {
+        gs_real d = fabs(f->r[rix(k, k)]);
+        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
+            return GS_EINVAL;
+        }
+    }
+    back_sub(f->r, f->zx, &p->c[0]);
+    back_sub(f->r, f->zy, &p->c[3]);
+    for (k = 0; base && k < 6; k++) {
+        p->c[k] += base->c[k];
+    }
+    return GS_OK;
+}
+#endif
+
 gs_status gs_fit_solve(const gs_fit *f, gs_fit_result *out)
 {
     return solve_par(f, out, NULL, NULL);
@@ -268,9 +296,11 @@ typedef struct {
     float w;        /* prior weight (> 0); 0 marks a cached sample the fits skip */
 } gs_fsamp;
 
-/* Window samples unpacked on the stack by a fast build (1.5 KB with their residuals
- * and keys where gs_real is float, 9 KB in double) */
+/* Window samples unpacked on the stack by a fast build (2.3 KB with their residuals
+ * and keys where gs_real is float, 20 KB in double) */
 #define GS_FIT_CACHE (GS_REAL_IS_FLOAT ? 64u : 256u)
+/* Fast builds: LMS triples already drawn, one bit each, for windows with at most this many */
+#define GS_FIT_SEEN_BITS 4096u
 
 typedef struct {
     const gs_ring *ring;
@@ -281,10 +311,19 @@ typedef struct {
     gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
+    gs_real *exy;             /* fast double builds: ... and their x, y residuals, side by side */
     uint32_t *key;            /* the median's selection scratch */
     float *med_key;           /* fast builds: the last median's squared residual, as a float */
     gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y (3 rows of m) */
+    struct gs_wlast *last;    /* fast builds: the last reweighting's sums, solved in full only at the end */
 } gs_win;
+
+/* A reweighting's fit and, when based, the curve its sums were taken about. */
+typedef struct gs_wlast {
+    gs_fit f;
+    gs_par base;
+    bool based;
+} gs_wlast;
 
 static uint32_t xorshift32(uint32_t *state)
 {
@@ -425,6 +464,33 @@ static float select_key(uint32_t *key, uint32_t n, uint32_t k)
     return v;
 }
 
+#if GS_FIT_FAST
+/* select_key with a guess: the keys within a quarter of hint_key's value either way go
+ * to buf, the ones below are counted; when the k-th lies among them it is selected from
+ * those few (every key below ranks before them, every key above after), else from all.
+ * The same key either way. */
+static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, float hint_key)
+{
+    float lo = hint_key * 0.75f, hi = hint_key * 1.25f;
+    uint32_t lo_b, hi_b, below = 0, m = 0, i;
+    if (n < 16u || !(hint_key > 0.0f) || !(hi < (float)INFINITY)) { /* (few keys: the pass costs what it saves) */
+        return select_key(key, n, k);
+    }
+    memcpy(&lo_b, &lo, sizeof lo_b);
+    memcpy(&hi_b, &hi, sizeof hi_b);
+    for (i = 0; i < n; i++) {
+        uint32_t x = key[i];
+        below += (uint32_t)(x < lo_b);
+        buf[m] = x;
+        m += (uint32_t)(x - lo_b < hi_b - lo_b); /* lo_b <= x < hi_b (below lo_b wraps high) */
+    }
+    if (below <= k && k < below + m) {
+        return select_key(buf, m, k - below);
+    }
+    return select_key(key, n, k);
+}
+#endif
+
 /* Median residual norm of the usable samples: the lower median of the squared
  * residuals as floats (squares order like norms: one sqrt for the median). The
  * keys sharing a prefix go to the buffer for select_key; while more than
@@ -460,6 +526,11 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 ey = vy - (v3 + tau * (v4 + tau * v5));
                 r2 = ex * ex + ey * ey;
                 memcpy(&wn->r2[i], &r2, sizeof r2);
+                {
+                    gs_v2d e0 = __builtin_shuffle(ex, ey, (gs_v2l){0, 2}), e1 = __builtin_shuffle(ex, ey, (gs_v2l){1, 3});
+                    memcpy(&wn->exy[2u * i], &e0, sizeof e0);
+                    memcpy(&wn->exy[2u * i + 2u], &e1, sizeof e1);
+                }
                 f0 = (float)r2[0];
                 f1 = (float)r2[1];
                 memcpy(&wn->key[i], &f0, sizeof f0);
@@ -476,10 +547,12 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 gs_real r2 = ex * ex + ey * ey;
                 float f = (float)r2;
                 wn->r2[i] = r2;
+                wn->exy[2u * i] = ex;
+                wn->exy[2u * i + 1u] = ey;
                 memcpy(&wn->key[n++], &f, sizeof f);
             }
         }
-        v = select_key(wn->key, n, (n - 1) / 2);
+        v = select_near(wn->key, wn->key + GS_FIT_CACHE, n, (n - 1) / 2, *wn->med_key);
         *wn->med_key = v;
         return sqrt((gs_real)v);
     }
@@ -745,8 +818,62 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
 #if defined(__GNUC__)
     gs_v2d p0 = {base->c[0], base->c[3]}, p1 = {base->c[1], base->c[4]}, p2 = {base->c[2], base->c[5]};
     gs_v2d ee = {g0, g0}, v0 = ee, v1 = ee, v2 = ee;
+    if (mode == W_TUKEY && r2) {
+        /* an IRLS step: the residuals from model (= base) the median left, 32 samples a word */
+        uint32_t i0;
+        for (i0 = 0; i0 < wn->count; i0 += 32u) {
+            uint32_t end = wn->count - i0 < 32u ? wn->count : i0 + 32u, mask;
+            word = 0;
+            for (i = i0; i < end; i++) {
+                float w = wn->cache[i].w;
+                gs_real r, u, tau, wr, wt;
+                gs_v2d wv, wtv, e;
+                if (!(w > 0.0f)) {
+                    continue;
+                }
+                r = sqrt(r2[i]);
+                if (!(r < cut)) {
+                    continue;
+                }
+                u = r / cut;
+                u = GS_R(1.0) - u * u;
+                w = (float)((gs_real)w * (u * u));
+                if (!(w > 0.0f)) {
+                    continue;
+                }
+                tau = wn->cache[i].tau;
+                wr = (gs_real)w;
+                word |= 1u << (i - i0);
+                wv = (gs_v2d){wr, wr};
+                memcpy(&e, &wn->exy[2u * i], sizeof e);
+                ee += wv * e * e;
+                g0 += wr;
+                v0 += wv * e;
+                wt = wr * tau;
+                wtv = (gs_v2d){wt, wt};
+                g1 += wt;
+                v1 += wtv * e;
+                wt *= tau;
+                wtv = (gs_v2d){wt, wt};
+                g2 += wt;
+                v2 += wtv * e;
+                wt *= tau;
+                g3 += wt;
+                wt *= tau;
+                g4 += wt;
+                n++;
+            }
+            mask = end - i0 == 32u ? ~0u : (1u << (end - i0)) - 1u;
+            keep[i0 >> 5] = (keep[i0 >> 5] & ~mask) | word;
+        }
+        i = wn->count; /* the general loop below has nothing left */
+    } else {
+        i = 0;
+    }
+#else
+    i = 0;
 #endif
-    for (i = 0; i < wn->count; i++) {
+    for (; i < wn->count; i++) {
         const gs_fsamp *s = &wn->cache[i];
         float w = s->w;
         if (!(w > 0.0f)) {
@@ -865,6 +992,13 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE) {
         wsums_cached(wn, model, &base, mode, cut, keep, r2, &a);
         wsums_to_fit(&a, &f);
+        if (!out) {
+            /* an IRLS step: the curve now, the result from the kept sums when the run ends */
+            wn->last->f = f;
+            wn->last->base = base;
+            wn->last->based = true;
+            return solve_par_only(&f, p, &base);
+        }
         return solve_par(&f, out, p, &base);
     }
 #endif
@@ -889,6 +1023,14 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     if (!GS_REAL_IS_FLOAT) {
         wsums_to_fit(&a, &f);
     }
+#if GS_FIT_FAST
+    if (!out) {
+        wn->last->f = f;
+        wn->last->base = base;
+        wn->last->based = !GS_REAL_IS_FLOAT;
+        return solve_par_only(&f, p, GS_REAL_IS_FLOAT ? NULL : &base);
+    }
+#endif
     return solve_par(&f, out, p, GS_REAL_IS_FLOAT ? NULL : &base);
 }
 
@@ -934,6 +1076,14 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     bool found = false;
 #if GS_FIT_FAST
     float best_key = 0.0f; /* *best_med's squared residual as a float, once found */
+    /* a short window draws the same triple again and again: its curve, median and
+     * verdict are the ones already had, so it is skipped (a bit per possible triple) */
+    uint32_t span_c = m - 2 * third, n_triples = third * third * span_c;
+    uint32_t seen[GS_FIT_SEEN_BITS / 32u];
+    bool dedup = n_triples <= GS_FIT_SEEN_BITS;
+    if (dedup) {
+        memset(seen, 0, ((n_triples + 31u) / 32u) * sizeof seen[0]);
+    }
 #endif
     *best_med = (gs_real)INFINITY;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
@@ -942,6 +1092,15 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
         gs_par p;
         gs_real med;
+#if GS_FIT_FAST
+        if (dedup) {
+            uint32_t t = (ka * third + (kb - third)) * span_c + (kc - 2 * third);
+            if (seen[t >> 5] & (1u << (t & 31u))) {
+                continue;
+            }
+            seen[t >> 5] |= 1u << (t & 31u);
+        }
+#endif
         if (!par_through_usable(wn, ka, kb, kc, &p)) {
             continue;
         }
@@ -1002,10 +1161,17 @@ static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_
             scale = floor_px;
         }
         /* the median just computed the residuals from fin that the weights need */
+#if GS_FIT_FAST
+        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, NULL, wn->r2);
+        if (st != GS_OK) {
+            return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
+        }
+#else
         st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, wn->r2);
         if (st != GS_OK) {
             return st;
         }
+#endif
         /* Settled when the curve moves by far less than the noise. */
         settled = par_max_shift_px(fin, &next) <= GS_R(1e-6) * scale;
         *fin = next;
@@ -1013,7 +1179,11 @@ static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_
             break;
         }
     }
+#if GS_FIT_FAST
+    return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
+#else
     return GS_OK;
+#endif
 }
 
 /* Robust loss of a curve: prior-weighted Tukey rho at the noise floor's cut-off
@@ -1227,10 +1397,12 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
 {
     gs_fsamp cache[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
     gs_real r2[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
-    uint32_t key[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
+    uint32_t key[GS_FIT_FAST ? 2u * GS_FIT_CACHE : 1u]; /* the keys, and select_near's few */
 #if GS_FIT_FAST
     float med_key = 0.0f;
     gs_real soa[GS_REAL_IS_FLOAT ? 1u : 3u * GS_FIT_CACHE];
+    gs_real exy[2u * GS_FIT_CACHE];
+    gs_wlast last;
 #endif
     gs_win wn;
     uint32_t i;
@@ -1241,6 +1413,8 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
 #if GS_FIT_FAST
     wn.med_key = &med_key;
     wn.soa = soa;
+    wn.exy = exy;
+    wn.last = &last;
 #endif
     if (!out) {
         return GS_EINVAL;

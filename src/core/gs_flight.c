@@ -93,16 +93,22 @@
 static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
 
 
+/* The flight's sample indices are 32-bit offsets from f->base (64-bit compares and
+ * adds cost code on a 32-bit core): the ring index of offset i, and the offset of a
+ * held ring index (held samples are never before the base: see rebase). */
+static uint64_t ring_idx(const gs_flight *f, uint32_t i) { return f->base + i; }
+static NOINLINE uint32_t idx_of(const gs_flight *f, uint64_t ring_i) { return (uint32_t)(ring_i - f->base); }
+
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
-static const gs_sample_full *at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
+static const gs_sample_full *at(const gs_flight *f, uint32_t i, gs_sample_full *buf)
 {
-    return gs_ring_get(f->ring, i, buf) ? buf : NULL;
+    return gs_ring_get(f->ring, ring_idx(f, i), buf) ? buf : NULL;
 }
 
 /* time of ring sample i, GS_T_NONE when not held */
-static int64_t t_at(const gs_flight *f, uint64_t i)
+static int64_t t_at(const gs_flight *f, uint32_t i)
 {
-    const gs_sample *s = gs_ring_at(f->ring, i);
+    const gs_sample *s = gs_ring_at(f->ring, ring_idx(f, i));
     return s ? gs_ring_sample_t_us(f->ring, s) : GS_T_NONE;
 }
 
@@ -113,7 +119,7 @@ static bool usable(const gs_sample_full *s)
     return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px);
 }
 
-static bool held(const gs_flight *f, uint64_t i) { return gs_ring_at(f->ring, i) != NULL; }
+static bool held(const gs_flight *f, uint32_t i) { return gs_ring_at(f->ring, ring_idx(f, i)) != NULL; }
 
 /* t1 - t0 longer than a span (false when either time is unknown) */
 static NOINLINE bool span_over(int64_t t1_us, int64_t t0_us, int64_t span_us)
@@ -129,18 +135,18 @@ static NOINLINE int64_t past_us(int64_t t_us, int64_t T_us, int side)
 }
 
 /* Ring sample i unpacked into *buf when held and usable, else NULL. */
-static const gs_sample_full *usable_at(const gs_flight *f, uint64_t i, gs_sample_full *buf)
+static const gs_sample_full *usable_at(const gs_flight *f, uint32_t i, gs_sample_full *buf)
 {
     const gs_sample_full *s = at(f, i, buf);
     return usable(s) ? s : NULL;
 }
 
 /* usable samples among [lo, hi] */
-static NOINLINE uint32_t count_usable(const gs_flight *f, uint64_t lo, uint64_t hi)
+static NOINLINE uint32_t count_usable(const gs_flight *f, uint32_t lo, uint32_t hi)
 {
     uint32_t n = 0;
     gs_sample_full b;
-    for (uint64_t i = lo; i <= hi; i++) n += usable_at(f, i, &b) ? 1u : 0u;
+    for (uint32_t i = lo; i <= hi; i++) n += usable_at(f, i, &b) ? 1u : 0u;
     return n;
 }
 
@@ -246,13 +252,13 @@ static gs_real med3(gs_real a, gs_real b, gs_real c)
     return a > b ? a : b;
 }
 
-static void restart_levels(gs_flight *f, uint64_t i);
+static void restart_levels(gs_flight *f, uint32_t i);
 static float last_stand_size(const gs_flight *f);
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
-    if (!f || !cfg || !ring || !keep) return GS_EINVAL;
+    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP) return GS_EINVAL;
     memset(f, 0, sizeof *f);
     f->cfg = cfg;
     f->ring = ring;
@@ -266,13 +272,15 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->max_gap_us = gs_time_us_of_cfg_s(cfg->max_gap_s);
     f->landing_latency_us = gs_time_us_of_cfg_s(cfg->landing_latency_s);
     f->state = GS_FS_IDLE;
-    f->next = gs_ring_head(ring);
+    uint64_t head = gs_ring_head(ring);
+    f->base = head > GS_FLIGHT_IDX_KEEP ? head - GS_FLIGHT_IDX_KEEP : 0u;
+    f->next = idx_of(f, head);
     f->quiet_from = f->next;
     f->last_t_us = GS_T_NONE;
     f->up_x = GS_R(0.0);
     f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
     f->noise_px = NAN;
-    restart_levels(f, UINT64_MAX);  /* no level seen yet */
+    restart_levels(f, GS_NO_IDX);  /* no level seen yet */
     f->dt_med_q4 = 0;               /* no frame interval seen yet */
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
@@ -356,7 +364,7 @@ static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sam
 }
 
 /* Ring sample i when usable and no gross outlier against the fit r (its z in *z), else NULL. */
-static const gs_sample_full *tested_at(const gs_flight *f, const gs_fit_result *r, uint64_t i,
+static const gs_sample_full *tested_at(const gs_flight *f, const gs_fit_result *r, uint32_t i,
                                        gs_sample_full *buf, gs_real *z)
 {
     const gs_sample_full *s = usable_at(f, i, buf);
@@ -441,7 +449,7 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
 }
 
 /* the object's size in px for gating: standing stature, or the rigid object's latest size */
-static gs_real gate_size(const gs_flight *f, uint64_t idx)
+static gs_real gate_size(const gs_flight *f, uint32_t idx)
 {
     if (IS_RIGID(f)) {
         gs_sample_full s_b;
@@ -512,9 +520,9 @@ static NOINLINE void fit_add(gs_flight *f, const gs_sample_full *s)
 }
 
 /* the oldest sample a flight may reach back to: held, and after the last closed candidate */
-static NOINLINE uint64_t history_floor(const gs_flight *f)
+static NOINLINE uint32_t history_floor(const gs_flight *f)
 {
-    uint64_t oldest = gs_ring_oldest(f->ring);
+    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
     return f->quiet_from > oldest ? f->quiet_from : oldest;
 }
 
@@ -524,7 +532,7 @@ static NOINLINE uint64_t history_floor(const gs_flight *f)
 typedef struct {
     bool valid;
 #ifndef __OPTIMIZE_SIZE__
-    uint64_t first;
+    uint32_t first;
     uint32_t count;
     float min_scale;
     gs_fit_method method;
@@ -534,18 +542,18 @@ typedef struct {
 } fit_memo;
 
 /* gs_fit_robust of ring samples [first, first+count) into f->keep, once per memo */
-static gs_status robust_fit(gs_flight *f, fit_memo *m, uint64_t first, uint32_t count, gs_fit_method method,
+static gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, uint32_t count, gs_fit_method method,
                             float min_scale, gs_fit_result *r)
 {
 #ifdef __OPTIMIZE_SIZE__
     (void)m;  /* the firmware's code budget is full: it fits again */
-    return gs_fit_robust(f->ring, first, count, method, min_scale, f->keep, r);
+    return gs_fit_robust(f->ring, ring_idx(f, first), count, method, min_scale, f->keep, r);
 #else
     if (m->valid && m->first == first && m->count == count && m->method == method && m->min_scale == min_scale) {
         *r = m->r;
         return m->st;
     }
-    m->st = gs_fit_robust(f->ring, first, count, method, min_scale, f->keep, r);
+    m->st = gs_fit_robust(f->ring, ring_idx(f, first), count, method, min_scale, f->keep, r);
     m->first = first;
     m->count = count;
     m->method = method;
@@ -558,7 +566,7 @@ static gs_status robust_fit(gs_flight *f, fit_memo *m, uint64_t first, uint32_t 
 
 /* Rebuild the running fit robustly from the ring samples [lo, hi]; *r: its solution
  * when true (scratch otherwise). */
-static bool refit_range(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, gs_fit_result *r)
+static bool refit_range(gs_flight *f, fit_memo *m, uint32_t lo, uint32_t hi, gs_fit_result *r)
 {
     int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi);
     if (t_lo == GS_T_NONE || t_hi == GS_T_NONE || hi <= lo) return false;
@@ -568,7 +576,7 @@ static bool refit_range(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, gs_
         return false;
     int64_t tspan = t_hi - t_lo;
     gs_fit_init(&f->fit, t_lo + tspan / 2, tspan > 0 ? tspan : frame_dt_us(f));
-    for (uint64_t i = lo; i <= hi; i++) {
+    for (uint32_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = usable_at(f, i, &s_b);
         if (s && gs_fit_kept(f->keep, (uint32_t)(i - lo))) fit_add(f, s);
@@ -579,15 +587,15 @@ static bool refit_range(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, gs_
 /* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
  * the alarm: if the samples at the edge then sit on the parabola, it was a
  * false alarm (true contact deviates by far more than a refit can absorb). */
-static bool alarm_is_false(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, uint64_t edge, int side)
+static bool alarm_is_false(gs_flight *f, fit_memo *m, uint32_t lo, uint32_t hi, uint32_t edge, int side)
 {
     gs_fit_result r;
     if (!refit_range(f, m, lo, hi, &r)) return false;
     /* a refit that only fits with a residual far above the noise proves nothing */
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
-    uint64_t stop = side > 0 ? lo : hi;  /* walking inward from the edge */
-    for (uint64_t i = edge, k = 0; k < 4 && checked < 2; k++) {
+    uint32_t stop = side > 0 ? lo : hi;  /* walking inward from the edge */
+    for (uint32_t i = edge, k = 0; k < 4 && checked < 2; k++) {
         gs_sample_full s_b;
         gs_real z;
         if (tested_at(f, &r, i, &s_b, &z)) {
@@ -600,13 +608,13 @@ static bool alarm_is_false(gs_flight *f, fit_memo *m, uint64_t lo, uint64_t hi, 
     return checked == 2;
 }
 
-static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, int64_t half_us)
+static bool seed_core_width(gs_flight *f, uint32_t apex, uint32_t newest, int64_t half_us)
 {
     uint32_t half = frame_steps(f, half_us, 1);
     if (half < 2) half = 2;
-    uint64_t floor_idx = history_floor(f);
-    uint64_t lo = apex > floor_idx + half ? apex - half : floor_idx;
-    uint64_t hi = apex + half < newest ? apex + half : newest;
+    uint32_t floor_idx = history_floor(f);
+    uint32_t lo = apex > floor_idx + half ? apex - half : floor_idx;
+    uint32_t hi = apex + half < newest ? apex + half : newest;
     /* need at least 5 usable samples: widen when frames are missing */
     for (int widen = 0; widen < 8; widen++) {
         if (count_usable(f, lo, hi) >= 5) break;
@@ -633,7 +641,7 @@ static bool seed_core_width(gs_flight *f, uint64_t apex, uint64_t newest, int64_
 }
 
 /* Seed a flight at an apex: fit a core around it, wider when noise hides the curve. */
-static bool seed_core(gs_flight *f, uint64_t apex, uint64_t newest)
+static bool seed_core(gs_flight *f, uint32_t apex, uint32_t newest)
 {
     static const int32_t half_us[] = {CORE_HALF_US, CORE_HALF_US * 145 / 100, CORE_HALF_US * 19 / 10};
     for (unsigned k = 0; k < sizeof half_us / sizeof half_us[0]; k++)
@@ -699,11 +707,67 @@ static gs_real pw_ssr_solve(gs_real A[4][4], gs_real b[4], gs_real yy, gs_real c
     return ssr_left(yy3, c, b3, 3);
 }
 
+#ifndef __OPTIMIZE_SIZE__
+/* Hosts: solve_spd in two steps, so that the leading 3 x 3 rows of the factor, which the
+ * boundary's grid points share, are taken once (the same arithmetic in the same order). */
+/* Rows [i0, k) of the Cholesky factor L of the k x k (k <= 4) symmetric A; false if not PD. */
+static bool chol_rows(gs_real A[4][4], gs_real L[4][4], int i0, int k)
+{
+    const gs_real tiny = sizeof(gs_real) < sizeof(double) ? GS_R(1e-6) : GS_R(1e-12);  /* as solve_spd */
+    for (int i = i0; i < k; i++) {
+        for (int j = 0; j <= i; j++) {
+            gs_real s = A[i][j];
+            for (int m = 0; m < j; m++) s -= L[i][m] * L[j][m];
+            if (i == j) {
+                if (!(s > tiny * (A[i][i] > 0 ? A[i][i] : GS_R(1.0)))) return false;
+                L[i][i] = GS_SQRT(s);
+            } else {
+                L[i][j] = s / L[j][j];
+            }
+        }
+    }
+    return true;
+}
+
+/* Solve L L^T c = b for the k x k factor L (solve_spd's substitutions). */
+static void chol_solve(gs_real L[4][4], const gs_real b[4], int k, gs_real c[4])
+{
+    gs_real y[4];
+    for (int i = 0; i < k; i++) {
+        gs_real s = b[i];
+        for (int m = 0; m < i; m++) s -= L[i][m] * y[m];
+        y[i] = s / L[i][i];
+    }
+    for (int i = k - 1; i >= 0; i--) {
+        gs_real s = y[i];
+        for (int m = i + 1; m < k; m++) s -= L[m][i] * c[m];
+        c[i] = s / L[i][i];
+    }
+}
+
+/* pw_ssr_solve with L's first three rows given (l3: A's leading 3 x 3 is PD) */
+static gs_real pw_ssr_solve_l3(gs_real A[4][4], gs_real b[4], gs_real yy, gs_real c3_min, gs_real c3_max,
+                               gs_real L[4][4], bool l3)
+{
+    gs_real c[4];
+    bool solved = A[3][3] > GS_R(0.0) && l3 && chol_rows(A, L, 3, 4);
+    if (solved) chol_solve(L, b, 4, c);
+    if (solved && c[3] >= c3_min && c[3] <= c3_max) return ssr_left(yy, c, b, 4);
+    gs_real al = A[3][3] > GS_R(0.0) ? ((solved && c[3] > c3_max) ? c3_max : c3_min) : GS_R(0.0);
+    gs_real b3[4];
+    for (int k = 0; k < 3; k++) b3[k] = b[k] - al * A[k][3];
+    gs_real yy3 = yy - GS_R(2.0) * al * b[3] + al * al * A[3][3];
+    if (!l3) return INFINITY;
+    chol_solve(L, b3, 3, c);
+    return ssr_left(yy3, c, b3, 3);
+}
+#endif
+
 /* Weighted SSR of u over samples [lo, hi] under parabola + alpha/2 (T - t)^2 for t < T
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
  * boundary placed inside the flight could absorb flight samples for free. */
-static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_lo, int64_t t_hi,
+static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_lo, int64_t t_hi,
                             int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px,
                             const gs_fit_result *r)
 {
@@ -715,7 +779,7 @@ static gs_real piecewise_ssr(const gs_flight *f, uint64_t lo, uint64_t hi, int64
     /* tau in [-1, 1] over [t_lo, t_hi]: centre tc, half-width ts */
     gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
     gs_real ts2 = ts * ts;
-    for (uint64_t i = lo; i <= hi; i++) {
+    for (uint32_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         gs_real z;
         const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
@@ -750,20 +814,22 @@ typedef struct {
 typedef struct {
     gs_real A[3][3], b[3], yy, ts2;
     uint32_t n;
+    bool l3;
+    gs_real L[4][4];  /* rows 0-2: the Cholesky factor of A, when l3 (row 3: each grid point's) */
     pw_sample s[PW_CACHE];
 } pw_sums;
 
 /* pw's T-independent sums over [lo, hi]; false when more than PW_CACHE samples lie past
  * T_reach (the grid point reaching furthest into the flight) */
-static bool pw_prepare(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_lo, int64_t t_hi,
+static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_lo, int64_t t_hi,
                        int64_t T_reach, int side, const gs_fit_result *r, pw_sums *P)
 {
-    memset(P, 0, offsetof(pw_sums, s));
+    memset(P, 0, offsetof(pw_sums, L));
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
     gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
     P->ts2 = ts * ts;
-    for (uint64_t i = lo; i <= hi; i++) {
+    for (uint32_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         gs_real z;
         const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
@@ -787,11 +853,15 @@ static bool pw_prepare(const gs_flight *f, uint64_t lo, uint64_t hi, int64_t t_l
             c->u = u;
         }
     }
+    gs_real A4[4][4] = {{0}};
+    for (int k = 0; k < 3; k++)
+        for (int m = 0; m < 3; m++) A4[k][m] = P->A[k][m];
+    P->l3 = chol_rows(A4, P->L, 0, 3);
     return true;
 }
 
 /* piecewise_ssr at T from the prepared sums */
-static gs_real pw_ssr_at(const pw_sums *P, int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
+static gs_real pw_ssr_at(pw_sums *P, int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
 {
     gs_real A[4][4] = {{0}}, b[4] = {0};
     for (int k = 0; k < 3; k++) {
@@ -811,14 +881,14 @@ static gs_real pw_ssr_at(const pw_sums *P, int64_t T, int side, gs_real alpha_mi
         }
         A[3][3] += w * h * h;
     }
-    return pw_ssr_solve(A, b, P->yy, alpha_min_px * P->ts2, alpha_max_px * P->ts2);
+    return pw_ssr_solve_l3(A, b, P->yy, alpha_min_px * P->ts2, alpha_max_px * P->ts2, P->L, P->l3);
 }
 #endif
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
  * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
-static int64_t refine_boundary(const gs_flight *f, uint64_t lo, uint64_t hi, int side,
-                               uint64_t edge_in, uint64_t edge_out, gs_real penalty,
+static int64_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int side,
+                               uint32_t edge_in, uint32_t edge_out, gs_real penalty,
                                const gs_fit_result *r)
 {
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
@@ -889,12 +959,12 @@ static gs_real stand_size(const gs_flight *f, gs_real *se_out)
     return NAN;
 }
 
-static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real *se_out)
+static gs_real rigid_size(const gs_flight *f, uint32_t lo, uint32_t hi, gs_real *se_out)
 {
     float v[MEDIAN_MAX];
     uint32_t n = 0;
-    uint64_t step = (hi - lo + MEDIAN_MAX) / MEDIAN_MAX;
-    for (uint64_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
+    uint32_t step = (hi - lo + MEDIAN_MAX) / MEDIAN_MAX;
+    for (uint32_t i = lo; i <= hi && n < MEDIAN_MAX; i += step) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         if (s && size_ok(s->size_px)) v[n++] = s->size_px;
@@ -906,16 +976,16 @@ static gs_real rigid_size(const gs_flight *f, uint64_t lo, uint64_t hi, gs_real 
  * Every sample but gross outliers enters the running fit (so a biased early
  * fit corrects itself); the flight's edge is the last sample after which the
  * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end. */
-static uint64_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
+static uint32_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
 {
-    uint64_t alarm = UINT64_MAX;
+    uint32_t alarm = GS_NO_IDX;
     uint32_t outl = 0;
     gs_real S = GS_R(0.0);
-    uint64_t floor_idx = history_floor(f);
+    uint32_t floor_idx = history_floor(f);
     int64_t t_prev = t_at(f, f->fl_first);
     int64_t t_seed = t_at(f, f->seed_idx);
-    uint64_t clean = f->fl_first;
-    uint64_t i = f->fl_first;
+    uint32_t clean = f->fl_first;
+    uint32_t i = f->fl_first;
     while (i > floor_idx) {
         i--;
         gs_sample_full s_b;
@@ -947,7 +1017,7 @@ static uint64_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
         gs_fit_solve(&f->fit, r);
         if (S == GS_R(0.0)) clean = i;
     }
-    if (clean != f->fl_first || alarm != UINT64_MAX) {
+    if (clean != f->fl_first || alarm != GS_NO_IDX) {
         f->fl_first = clean;
         gs_fit_result rr;  /* r changes only when the refit succeeds */
         if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, r);
@@ -960,14 +1030,14 @@ static uint64_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
  * deviation against gravity keeps growing, as under a constant contact force
  * (after an impact the body soon stops following it). Returns how many;
  * *outer = the outermost, *first = the nearest. */
-static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint64_t edge, int side,
-                            uint64_t *outer, uint64_t *first)
+static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t edge, int side,
+                            uint32_t *outer, uint32_t *first)
 {
-    uint64_t floor_idx = history_floor(f);
-    uint64_t head = gs_ring_head(f->ring);
+    uint32_t floor_idx = history_floor(f);
+    uint32_t head = idx_of(f, gs_ring_head(f->ring));
     uint32_t n = 0;
     gs_real z_prev = -INFINITY;
-    uint64_t i = edge;
+    uint32_t i = edge;
     *outer = edge;
     *first = edge;
     while (n < CONTACT_SAMPLES_MAX) {
@@ -989,10 +1059,10 @@ static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r,
  * samples past it (those end where contact was detected, alarm: further out the ground
  * phase is no longer a constant force); *outer = the outermost contact sample. */
 static int64_t boundary_time(const gs_flight *f, const gs_fit_result *r, int side, bool alarm,
-                            uint64_t edge, uint64_t other_edge, bool refine, gs_real pen,
-                            uint64_t *outer)
+                            uint32_t edge, uint32_t other_edge, bool refine, gs_real pen,
+                            uint32_t *outer)
 {
-    uint64_t first = edge;  /* the first contact sample */
+    uint32_t first = edge;  /* the first contact sample */
     *outer = edge;
     if (!refine) return GS_T_NONE;
     uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
@@ -1010,7 +1080,7 @@ static int64_t boundary_time(const gs_flight *f, const gs_fit_result *r, int sid
 
 /* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
  * not beyond the grown edge? (false when not held) */
-static bool inside_edge(const gs_flight *f, uint64_t i, int64_t T, int side, uint64_t edge)
+static bool inside_edge(const gs_flight *f, uint32_t i, int64_t T, int side, uint32_t edge)
 {
     int64_t t = t_at(f, i);
     if (t == GS_T_NONE) return false;
@@ -1020,10 +1090,10 @@ static bool inside_edge(const gs_flight *f, uint64_t i, int64_t T, int side, uin
 
 /* The flight's outermost sample on one side: from `from` step toward `to` (inward)
  * until a sample is inside the flight (inside_edge) or `to` is reached. */
-static NOINLINE uint64_t trim_edge(const gs_flight *f, uint64_t from, uint64_t to, int64_t T, int side,
-                                   uint64_t edge)
+static NOINLINE uint32_t trim_edge(const gs_flight *f, uint32_t from, uint32_t to, int64_t T, int side,
+                                   uint32_t edge)
 {
-    uint64_t i = from;
+    uint32_t i = from;
     while (i != to && !inside_edge(f, i, T, side, edge)) i = side < 0 ? i + 1 : i - 1;
     return i;
 }
@@ -1039,7 +1109,7 @@ static NOINLINE bool set_up(gs_flight *f, gs_real ux, gs_real uy)
 }
 
 /* Restart the seed's level trackers from ring sample i (from nothing when not held) */
-static NOINLINE void restart_levels(gs_flight *f, uint64_t i)
+static NOINLINE void restart_levels(gs_flight *f, uint32_t i)
 {
     gs_sample_full s_b;
     const gs_sample_full *s = at(f, i, &s_b);
@@ -1052,13 +1122,13 @@ static NOINLINE void restart_levels(gs_flight *f, uint64_t i)
 }
 
 /* Close the open candidate. right_alarm: the sample at which contact was
- * detected after the flight (UINT64_MAX when it ended otherwise). */
-static void close_candidate(gs_flight *f, fit_memo *m, uint64_t newest, uint64_t right_alarm, bool truncated)
+ * detected after the flight (GS_NO_IDX when it ended otherwise). */
+static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t right_alarm, bool truncated)
 {
-    uint64_t land_idx = UINT64_MAX;  /* first sample after the flight */
+    uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
     gs_fit_result r;
     if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
-    uint64_t left_alarm = grow_left(f, m, &r);
+    uint32_t left_alarm = grow_left(f, m, &r);
 
     /* boundary refinement on the up direction of the flight's own acceleration */
     gs_real save_ux = f->up_x, save_uy = f->up_y;
@@ -1066,7 +1136,7 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint64_t newest, uint64_t
         f->up_x = -r.ax_px_s2 / r.a_px_s2;
         f->up_y = -r.ay_px_s2 / r.a_px_s2;
     }
-    uint64_t L = f->fl_first, R = f->fl_last;
+    uint32_t L = f->fl_first, R = f->fl_last;
     /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
     float floor_off = NAN, floor_on = NAN, floor_before = NAN;
     int64_t F0 = GS_T_NONE, F1 = GS_T_NONE;
@@ -1106,9 +1176,9 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint64_t newest, uint64_t
     bool refine = held(f, L) && !(F0 != GS_T_NONE && F1 != GS_T_NONE);  /* a body's are its feet's where seen */
     gs_real sig = fit_sigma(f, &r);
     gs_real pen = DROP_PENALTY * sig * sig;
-    uint64_t lo, hi;  /* the outermost contact samples */
-    int64_t T0 = boundary_time(f, &r, -1, left_alarm != UINT64_MAX, L, R, refine, pen, &lo);
-    int64_t T1 = boundary_time(f, &r, +1, right_alarm != UINT64_MAX, R, L, refine, pen, &hi);
+    uint32_t lo, hi;  /* the outermost contact samples */
+    int64_t T0 = boundary_time(f, &r, -1, left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
+    int64_t T1 = boundary_time(f, &r, +1, right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         (long long)T0, (long long)T1, r.a_px_s2);
@@ -1120,8 +1190,8 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint64_t newest, uint64_t
         W0 = F0 - FEET_FREE_EDGE_US;
         W1 = F1 + FEET_FREE_EDGE_US;
     }
-    uint64_t in_lo = trim_edge(f, lo, hi, W0, -1, L);
-    uint64_t in_hi = trim_edge(f, hi, in_lo, W1, +1, R);
+    uint32_t in_lo = trim_edge(f, lo, hi, W0, -1, L);
+    uint32_t in_hi = trim_edge(f, hi, in_lo, W1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
 
@@ -1140,7 +1210,7 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint64_t newest, uint64_t
     uint32_t n_in = 0, n_out = 0;
     int64_t max_gap_in = 0;
     int64_t t_prev = GS_T_NONE;
-    for (uint64_t i = in_lo; i <= in_hi; i++) {
+    for (uint32_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s || !(s->w > 0.0f)) continue;  /* frames missing from the source */
@@ -1280,24 +1350,24 @@ done:
     /* the next flight may start right after this landing: its take-off side must
      * see the contact samples that follow it */
     f->quiet_from = newest;
-    if (land_idx != UINT64_MAX && land_idx < newest) f->quiet_from = land_idx;
+    if (land_idx != GS_NO_IDX && land_idx < newest) f->quiet_from = land_idx;
     restart_levels(f, newest);  /* next seeds start after the landing */
 }
 
 /* ---- the per-sample state machine ------------------------------------------ */
 
-static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s);
+static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s);
 
 /* |du/dt| against the sample about lag_us back (frame jitter is not motion); NaN unknown */
-static gs_real speed_px_s(const gs_flight *f, uint64_t idx, const gs_sample_full *s, gs_real u, int64_t lag_us)
+static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full *s, gs_real u, int64_t lag_us)
 {
-    uint64_t k = frame_steps(f, lag_us, 1);
+    uint32_t k = frame_steps(f, lag_us, 1);
     if (k < 1) k = 1;
-    if (idx < gs_ring_oldest(f->ring) + k) return NAN;
+    if (idx < idx_of(f, gs_ring_oldest(f->ring)) + k) return NAN;
     gs_sample_full b_b;
 #ifndef __OPTIMIZE_SIZE__
     /* usable_at reading only what the test and the speed need */
-    const gs_sample *rs = gs_ring_at(f->ring, idx - k);
+    const gs_sample *rs = gs_ring_at(f->ring, ring_idx(f, idx - k));
     if (!rs) return NAN;
     b_b.t_us = gs_ring_sample_t_us(f->ring, rs);
     b_b.x_px = rs->x_px;
@@ -1386,7 +1456,7 @@ static gs_real size_ref(const gs_flight *f, const gs_sample_full *s)
     return size_ok(s->size_px) ? (gs_real)s->size_px : NAN;
 }
 
-static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
+static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 {
     /* history for the median of three and second differences */
     if (f->n_hist == 3) {
@@ -1402,7 +1472,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     if (f->n_hist < 3) return;
 
     gs_real um = med3(f->u_hist[0], f->u_hist[1], f->u_hist[2]);
-    uint64_t im = f->i_hist[1];
+    uint32_t im = f->i_hist[1];
     int64_t tm = f->t_hist_us[1];
     gs_real d2 = f->u_hist[2] - GS_R(2.0) * f->u_hist[1] + f->u_hist[0];
     gs_real sz = size_ref(f, s);
@@ -1455,13 +1525,13 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     gs_real drop = SEED_DROP_NOISE * nz;
     if (GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
     if (f->peak_u - um <= drop) return;
-    uint64_t apex = f->peak_idx;
+    uint32_t apex = f->peak_idx;
     int64_t apex_t = f->peak_t_us;
     f->peak_u = -INFINITY;
     if (seed_core(f, apex, idx)) {
         set_state(f, GS_FS_AIRBORNE, apex_t);
         /* samples after the core that arrived meanwhile are tested in order */
-        for (uint64_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
+        for (uint32_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
             gs_sample_full p_b;
             const gs_sample_full *p = usable_at(f, i, &p_b);
             if (p) airborne_sample(f, i, p);
@@ -1469,7 +1539,7 @@ static void ground_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     }
 }
 
-static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_full *s)
+static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_full *s)
 {
     /* the COM may turn before the feet meet the floor (its model is not the body): while a
      * foot that left is still in the air, wait for it a little (the event still leaves well
@@ -1488,7 +1558,7 @@ static void land(gs_flight *f, uint64_t idx, uint64_t alarm, const gs_sample_ful
     set_state(f, GS_FS_GROUND, s->t_us);
 }
 
-static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
+static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 {
     if (f->feet_wait_us != GS_T_NONE) {  /* the COM landed: waiting for the feet */
         if (s->t_us >= f->feet_wait_us || !gs_feet_airborne(&f->feet)) land(f, idx, f->wait_alarm, s);
@@ -1497,20 +1567,20 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
     if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_us, t_at(f, f->seed_idx), f->max_flight_us)) {
-        land(f, idx, UINT64_MAX, s);
+        land(f, idx, GS_NO_IDX, s);
         return;
     }
     if (r.n >= 8 && !plausible_fall(f, &r, gate_size(f, idx))) {  /* a standing phase, not a flight */
-        land(f, idx, UINT64_MAX, s);
+        land(f, idx, GS_NO_IDX, s);
         return;
     }
-    uint64_t k = idx - f->fl_last - 1;  /* position among the pending samples */
-    if (k >= 32) { land(f, idx, UINT64_MAX, s); return; }
+    uint32_t k = idx - f->fl_last - 1;  /* position among the pending samples */
+    if (k >= 32) { land(f, idx, GS_NO_IDX, s); return; }
     gs_real z;
     bool ok = test_sample(f, &r, s, &z);
     DBG("t=%lld ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", (long long)s->t_us, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
-        if (++f->outliers_run >= 3) land(f, idx, UINT64_MAX, s);
+        if (++f->outliers_run >= 3) land(f, idx, GS_NO_IDX, s);
         return;
     }
     f->outliers_run = 0;
@@ -1534,7 +1604,7 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     f->pend_ok |= 1u << k;
     if (f->cusum == GS_R(0.0)) {
         /* everything pending was flight after all: take it in */
-        for (uint64_t j = f->fl_last + 1; j <= idx; j++) {
+        for (uint32_t j = f->fl_last + 1; j <= idx; j++) {
             gs_sample_full p_b;
             const gs_sample_full *p = usable_at(f, j, &p_b);
             if (p && (f->pend_ok & (1u << (uint32_t)(j - f->fl_last - 1))))
@@ -1545,13 +1615,35 @@ static void airborne_sample(gs_flight *f, uint64_t idx, const gs_sample_full *s)
     }
 }
 
+/* Keep the offsets small: once the ring's head is 2 x GS_FLIGHT_IDX_KEEP past the base,
+ * the base moves to GS_FLIGHT_IDX_KEEP before it (the ring holds fewer samples: no held
+ * sample falls before it). A stored index before the new base (never held) becomes 0,
+ * equally unheld and before every held one. */
+static NOINLINE void rebase(gs_flight *f)
+{
+    static const uint16_t idx_fields[] = {
+        offsetof(gs_flight, next), offsetof(gs_flight, quiet_from), offsetof(gs_flight, last_idx),
+        offsetof(gs_flight, i_hist[0]), offsetof(gs_flight, i_hist[1]), offsetof(gs_flight, i_hist[2]),
+        offsetof(gs_flight, peak_idx), offsetof(gs_flight, fl_first), offsetof(gs_flight, fl_last),
+        offsetof(gs_flight, seed_idx), offsetof(gs_flight, wait_alarm)};
+    uint64_t head = gs_ring_head(f->ring);
+    if (head - f->base <= 2u * (uint64_t)GS_FLIGHT_IDX_KEEP) return;
+    uint32_t by = idx_of(f, head - GS_FLIGHT_IDX_KEEP);
+    f->base += by;
+    for (unsigned k = 0; k < sizeof idx_fields / sizeof idx_fields[0]; k++) {
+        uint32_t *i = (uint32_t *)(void *)((char *)f + idx_fields[k]);
+        if (*i != GS_NO_IDX) *i = *i > by ? *i - by : 0u;
+    }
+}
+
 void gs_flight_update(gs_flight *f)
 {
-    uint64_t head = gs_ring_head(f->ring);
-    uint64_t oldest = gs_ring_oldest(f->ring);
+    rebase(f);
+    uint32_t head = idx_of(f, gs_ring_head(f->ring));
+    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
     if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */
     while (f->next < head) {
-        uint64_t idx = f->next++;
+        uint32_t idx = f->next++;
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
         /* a gap is frames missing from the source; a light frame (the head out of
@@ -1565,9 +1657,9 @@ void gs_flight_update(gs_flight *f)
             if (dt > f->max_gap_us) {
                 if (f->state == GS_FS_AIRBORNE) {
                     fit_memo m = {0};
-                    close_candidate(f, &m, f->last_idx, UINT64_MAX, true);
+                    close_candidate(f, &m, f->last_idx, GS_NO_IDX, true);
                 }
-                restart_levels(f, UINT64_MAX);  /* never held: from nothing */
+                restart_levels(f, GS_NO_IDX);  /* never held: from nothing */
                 set_state(f, GS_FS_GROUND, s->t_us);
             }
         }
@@ -1587,7 +1679,7 @@ static void end_flight(gs_flight *f)
     bool waited = f->feet_wait_us != GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
     fit_memo m = {0};
-    close_candidate(f, &m, f->last_idx, waited ? f->wait_alarm : UINT64_MAX, !waited);
+    close_candidate(f, &m, f->last_idx, waited ? f->wait_alarm : GS_NO_IDX, !waited);
     set_state(f, GS_FS_GROUND, f->last_t_us);
 }
 
