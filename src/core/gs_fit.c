@@ -36,6 +36,12 @@
 /* two doubles, for the hot loops over a cached window (element-wise IEEE, as scalars) */
 typedef double gs_v2d __attribute__((vector_size(16)));
 typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lanes: -1 true, 0 false */
+/* lanes i and j of the four in (a, b): GCC's and clang's spellings of the same shuffle */
+#ifdef __clang__
+#define GS_V2_PICK(a, b, i, j) __builtin_shufflevector(a, b, i, j)
+#else
+#define GS_V2_PICK(a, b, i, j) __builtin_shuffle(a, b, (gs_v2l){i, j})
+#endif
 #endif
 
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
@@ -527,7 +533,7 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 r2 = ex * ex + ey * ey;
                 memcpy(&wn->r2[i], &r2, sizeof r2);
                 {
-                    gs_v2d e0 = __builtin_shuffle(ex, ey, (gs_v2l){0, 2}), e1 = __builtin_shuffle(ex, ey, (gs_v2l){1, 3});
+                    gs_v2d e0 = GS_V2_PICK(ex, ey, 0, 2), e1 = GS_V2_PICK(ex, ey, 1, 3);
                     memcpy(&wn->exy[2u * i], &e0, sizeof e0);
                     memcpy(&wn->exy[2u * i + 2u], &e1, sizeof e1);
                 }
