@@ -234,11 +234,12 @@ void products_scalar(const float *X, const float *Y, int w, float *A, float *B, 
 }
 
 // one output row: the column's running sums (ColumnSum) and the smaller eigenvalue (calcMinEigenVal)
-void column_eigen_scalar(double *sum, const double *P, const double *M, int w, float *E)
+// (columns from `from` on: the planes stay w apart, so a vector loop's tail starts here)
+void column_eigen_scalar(double *sum, const double *P, const double *M, int w, float *E, int from = 0)
 {
     double *sa = sum, *sb = sum + w, *sc = sum + 2 * w;
     const double *pa = P, *pb = P + w, *pc = P + 2 * w, *ma = M, *mb = M + w, *mc = M + 2 * w;
-    for (int i = 0; i < w; i++) {
+    for (int i = from; i < w; i++) {
         const double s0a = sa[i] + pa[i], s0b = sb[i] + pb[i], s0c = sc[i] + pc[i];
         const float a = (float)s0a * 0.5f, b = (float)s0b, c = (float)s0c * 0.5f;
         sa[i] = s0a - ma[i];
@@ -297,18 +298,7 @@ __attribute__((target("avx2"))) void column_eigen_avx2(double *sum, const double
         const __m128 q = _mm_add_ps(_mm_mul_ps(t, t), _mm_mul_ps(b, b));
         _mm_storeu_ps(E + i, _mm_sub_ps(_mm_add_ps(a, c), _mm_sqrt_ps(q)));
     }
-    if (i < w) {
-        // the tail's running sums live at the same offsets of the three planes
-        for (; i < w; i++) {
-            const double s0a = sa[i] + pa[i], s0b = sb[i] + pb[i], s0c = sc[i] + pc[i];
-            const float a = (float)s0a * 0.5f, b = (float)s0b, c = (float)s0c * 0.5f;
-            sa[i] = s0a - ma[i];
-            sb[i] = s0b - mb[i];
-            sc[i] = s0c - mc[i];
-            const float t = a - c;
-            E[i] = (a + c) - std::sqrt(t * t + b * b);
-        }
-    }
+    column_eigen_scalar(sum, P, M, w, E, i);
 }
 
 bool have_avx2()
