@@ -779,7 +779,7 @@ int run(const Options &o)
             }
             flights->set_rolling_shutter(det->rolling_shutter_s_per_row());
             fe_jumps.clear();
-            flights->take_pending(f.t_s, false, fe_jumps);
+            flights->take_pending(f.t_s + det->clock_shift_s(), false, fe_jumps);
             for (const gs_ev_jump &j : fe_jumps) pipes.report(j);
         }
         if (progress && (f.index & 15) == 0 && now_s() > next_progress) {

@@ -203,6 +203,7 @@ struct Track {
     bool confirmed = false;
     std::vector<Pt> arc;           // detections since the last break of the parabola
     Pt last;                       // the newest detection (also when it started a new arc)
+    std::vector<Pt> recent;        // the newest detections across arcs (the clock's check)
     bool has_last = false;
     double d = 0;                  // running diameter (full res)
     double d_prev = kNaN;          // running diameter before the newest detection
@@ -218,6 +219,7 @@ constexpr size_t kArcKeep = 400;   // detections of an arc kept (1000 fps: 0.4 s
 constexpr size_t kFitLast = 24;    // newest arc points in the prediction fit
 constexpr size_t kMaxTracks = 48;  // tentative and confirmed
 constexpr size_t kMaxBlobs = 64;
+constexpr size_t kRecentKeep = 6;  // detections in the clock's check (one may be contact)
 
 // Rolling shutter: a row y is exposed k (y - H/2) later than the middle row, so a
 // ball moving at v appears displaced by v k (y - H/2). k is unknown (readout time,
@@ -338,6 +340,8 @@ struct BallDetector::Impl {
     long frame = 0;
     double dt = 1.0 / 30.0;        // typical frame interval
     double last_t = kNaN;
+    double prev_t = kNaN;          // the previous frame's time on the repaired clock
+    double clock_shift_s = 0.0;    // frames the encoder dropped, as time (added to the stream's)
     bool backlog = false;
     // gravity in the image, learnt from confirmed flights (unit vector, image down at first)
     double gx = 0.0, gy = 1.0;
@@ -364,6 +368,7 @@ struct BallDetector::Impl {
     void rs_segment(const std::vector<Pt> &arc, int rows);
     void rs_correct(double vx, double vy, double rows, double *x, double *y) const;
     bool make_obs(const Track &tr, const Pt &p, double vx, double vy, int rows, BallObs &o) const;
+    int dropped_frames(const std::vector<Blob> &blobs, double t_s) const;
     void process(const cv::Mat &bgr, double t_s, std::vector<BallObs> &out);
 };
 
@@ -855,6 +860,63 @@ void BallDetector::Impl::rs_correct(double vx, double vy, double rows, double *x
     *y -= vy * dtr;
 }
 
+// Frame times missing just before this frame (0 to 3): a ball seen in each of the
+// last frames, whose parabola explains them well, finds this frame's blob only where
+// its parabola is k + 1 frame times on. Every ball that shows it must agree; one
+// whose next position fits (or none fits: a bounce, a catch) shows nothing.
+int BallDetector::Impl::dropped_frames(const std::vector<Blob> &blobs, double t_s) const
+{
+    if (!std::isfinite(prev_t) || !(dt > 0.0)) return 0;
+    constexpr int kMaxDropped = 3;
+    int vote = -1;
+    std::vector<TrackPoint> tp;
+    for (const Track &tr : tracks) {
+        if (!tr.confirmed || !tr.has_last || tr.last.t != prev_t || tr.recent.size() < kRecentKeep) continue;
+        // seen in every frame of late (a track that skipped frames proves nothing)
+        bool consecutive = true;
+        for (size_t i = 1; i < tr.recent.size(); i++)
+            if (tr.recent[i].frame != tr.recent[i - 1].frame + 1) consecutive = false;
+        if (!consecutive) continue;
+        double D = std::max(tr.d, 2.0);
+        // the parabola of the newest detections, one left out (a contact, a merge)
+        // when that explains the others best
+        Parabola fit;
+        for (size_t skip = 0; skip <= tr.recent.size(); skip++) {
+            tp.clear();
+            for (size_t i = 0; i < tr.recent.size(); i++)
+                if (i != skip) tp.push_back({tr.recent[i].t, tr.recent[i].x, tr.recent[i].y, 1.0});
+            Parabola f = fit_parabola(tp);
+            if (f.ok && (!fit.ok || f.rms_px < fit.rms_px)) fit = f;
+        }
+        double tol = std::max(1.5, 0.05 * D);
+        if (!fit.ok || !(fit.rms_px < tol)) continue;
+        double e[kMaxDropped + 1];
+        for (int k = 0; k <= kMaxDropped; k++) {
+            double t = t_s + k * dt, px = fit.x(t), py = fit.y(t);
+            e[k] = std::numeric_limits<double>::infinity();
+            for (const Blob &b : blobs) {
+                double sr = b.d_minor_s / scale / D;
+                if (sr > 0.5 && sr < 2.0) e[k] = std::min(e[k], std::hypot(b.cx_s / scale - px, b.cy_s / scale - py));
+            }
+        }
+        if (std::getenv("GS_BALL_DEBUG"))
+            std::fprintf(stderr, "gap? t=%.3f D=%.1f rms=%.2f e=%.1f %.1f %.1f %.1f\n", t_s, D, fit.rms_px, e[0], e[1],
+                         e[2], e[3]);
+        int best = 0;
+        for (int k = 1; k <= kMaxDropped; k++)
+            if (e[k] < e[best]) best = k;
+        if (!(e[best] < 0.15 * D + 3.0 * tol)) continue;
+        // the other frame counts miss by a quarter diameter or more, and four times as far
+        bool sure = true;
+        for (int k = 0; k <= kMaxDropped; k++)
+            if (k != best && !(e[k] > std::max(0.25 * D, 4.0 * std::max(e[best], 1.0)))) sure = false;
+        if (!sure) continue;
+        if (vote >= 0 && vote != best) return 0;
+        vote = best;
+    }
+    return std::max(vote, 0);
+}
+
 // One detection as reported: centre corrected for the rolling shutter with the
 // velocity then; the diameter only where the matte is trustworthy.
 bool BallDetector::Impl::make_obs(const Track &tr, const Pt &p, double vx, double vy, int rows, BallObs &o) const
@@ -918,6 +980,7 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         dt = frame == 1 ? d : dt + 0.1 * (std::min(d, 3.0 * dt) - dt);
     }
     last_t = t_s;
+    t_s += clock_shift_s;
     const int64_t fidx = frame;
     frame++;
     scale = std::min(1.0, 960.0 / std::max(bgr.cols, bgr.rows));
@@ -1018,6 +1081,15 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         for (const Blob &b : blobs) cv::rectangle(vis, b.box_s, cv::Scalar(0, 255, 0), 1);
         cv::imwrite(path, vis);
     }
+
+    // a phone's encoder may drop frames and still stamp a constant rate: the balls'
+    // own parabolas then say how many frame times really passed
+    if (int k = dropped_frames(blobs, t_s); k > 0) {
+        if (std::getenv("GS_BALL_DEBUG")) std::fprintf(stderr, "clock: %d frame(s) dropped before %.3f s\n", k, t_s);
+        clock_shift_s += k * dt;
+        t_s += k * dt;
+    }
+    prev_t = t_s;
 
     // association: each track's prediction (its arc's parabola, else its chord),
     // confirmed balls first, then the longest tracks; greedy by normalised distance
@@ -1145,6 +1217,8 @@ void BallDetector::Impl::process(const cv::Mat &bgr, double t_s, std::vector<Bal
         if (tr.arc.size() > kArcKeep) tr.arc.erase(tr.arc.begin());
         tr.last = p;
         tr.has_last = true;
+        tr.recent.push_back(p);
+        if (tr.recent.size() > kRecentKeep) tr.recent.erase(tr.recent.begin());
         tr.fit = tr.arc.size() >= 3 ? fit_points(tr.arc, kFitLast) : Parabola();
         if (tr.confirmed || tr.arc.size() >= 3) {
             cv::Rect r = b.box_s;
@@ -1271,5 +1345,6 @@ void BallDetector::process(const cv::Mat &bgr, double t_s, std::vector<BallObs> 
 void BallDetector::set_backlog(bool on) { p_->backlog = on; }
 
 double BallDetector::rolling_shutter_s_per_row() const { return p_->rs_k; }
+double BallDetector::clock_shift_s() const { return p_->clock_shift_s; }
 
 }  // namespace gs

@@ -85,6 +85,9 @@ public:
     // Rolling shutter in use: seconds per row a ball's image is displaced by its
     // velocity times (row - rows/2); 0 when none was found (global shutter).
     double rolling_shutter_s_per_row() const;
+    // time added to the stream's for frames the encoder dropped (the observations'
+    // t_s include it)
+    double clock_shift_s() const;
 
 private:
     struct Impl;

@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <Eigen/Dense>
+
 extern "C" {
 #include "gravscale/gs_time.h"
 }
@@ -20,6 +22,7 @@ constexpr size_t kKeepObs = 20000;       // detections kept per track (1000 fps:
 // tennis and basket balls 0.02 /m); a flight may show up to this much of it
 constexpr double kDragMax_per_m = 0.05;
 constexpr double kTrendF = 12.0;         // F(2, n - 5) beyond p ~ 0.001: a trend, not noise
+constexpr double kGapF = 30.0;           // a dropped frame: F(1, 2n - 7) at the best place, far beyond noise's
 constexpr double kTrendSlack = 0.06;     // and beyond drag by this share of the acceleration
 // the camera's blur is assumed known to +-0.6 px^2 in variance, the matte's edge to 0.5 %
 constexpr double kPsfVarUnc_px2 = 0.6;
@@ -66,6 +69,65 @@ void trim_contact_ends(std::vector<BallObs> &pts, Parabola &fit)
             fit = f2;
         }
     }
+}
+
+// A phone's encoder may drop frames and still stamp a constant rate: the detections
+// after a dropped frame are stamped one frame time early and the parabola through
+// them bends. The flight is re-timed where one frame time more between two of its
+// detections (three or more on each side) explains the positions far better: an F
+// of kGapF for the one parameter at the best of the places tried (noise's maximum
+// over a flight's places stays near 2 ln n, about 10), and better than a smooth
+// trend does. Only a clock that stamps whole frame times; at most three gaps.
+// Returns the number inserted (fit refitted).
+// the residual sum of squares (x and y) of a polynomial of degree deg in time
+double poly_sse(const std::vector<BallObs> &pts, int deg)
+{
+    const Eigen::Index n = (Eigen::Index)pts.size();
+    double t0 = 0.5 * (pts.front().t_s + pts.back().t_s), ts = std::max(1e-9, 0.5 * (pts.back().t_s - pts.front().t_s));
+    Eigen::MatrixXd A(n, deg + 1), b(n, 2);
+    for (Eigen::Index i = 0; i < n; i++) {
+        double u = (pts[(size_t)i].t_s - t0) / ts, p = 1.0;
+        for (int k = 0; k <= deg; k++, p *= u) A(i, k) = p;
+        b(i, 0) = pts[(size_t)i].x_px;
+        b(i, 1) = pts[(size_t)i].y_px;
+    }
+    Eigen::MatrixXd r = A * A.colPivHouseholderQr().solve(b) - b;
+    return r.squaredNorm();
+}
+
+int retime_gaps(std::vector<BallObs> &pts, double dt, Parabola &fit)
+{
+    const size_t n = pts.size();
+    if (n < 8 || n > 400 || !(dt > 0.0) || !fit.ok) return 0;
+    for (size_t i = 1; i < n; i++) {
+        double k = (pts[i].t_s - pts[i - 1].t_s) / dt;
+        if (!(k > 0.5) || std::fabs(k - std::round(k)) > 0.1) return 0;
+    }
+    const double dof = 2.0 * ((double)n - 3.0);
+    std::vector<TrackPoint> tp(n);
+    int added = 0;
+    for (int g = 0; g < 3; g++) {
+        double sse0 = fit.rms_px * fit.rms_px * dof, sse1 = sse0;
+        size_t best = 0;
+        for (size_t j = 3; j + 3 <= n; j++) {
+            for (size_t i = 0; i < n; i++) tp[i] = {pts[i].t_s + (i >= j ? dt : 0.0), pts[i].x_px, pts[i].y_px, 1.0};
+            Parabola f = fit_parabola(tp);
+            double sse = f.ok ? f.rms_px * f.rms_px * dof : INFINITY;
+            if (sse < sse1) { sse1 = sse; best = j; }
+        }
+        double F = best ? (sse0 - sse1) / (sse1 / (dof - 1.0)) : 0.0;
+        // a step, not a smooth trend (a tilted camera, motion in depth): the quartic,
+        // with one parameter more per axis, must leave twice the gap's residual
+        double sse4 = best ? poly_sse(pts, 4) : 0.0;
+        if (debug())
+            std::fprintf(stderr, "      gap test: best at %zu of %zu, residual %.3f -> %.3f px (quartic %.3f), F %.1f\n", best,
+                         n, std::sqrt(sse0 / dof), std::sqrt(sse1 / dof), std::sqrt(sse4 / (dof - 4.0)), F);
+        if (!best || !(F > kGapF) || !(2.0 * sse1 < sse4)) break;
+        for (size_t i = best; i < n; i++) pts[i].t_s += dt;
+        fit = fit_obs(pts);
+        added++;
+    }
+    return added;
 }
 
 // the regularised incomplete beta function I_x(a, b) (continued fraction, modified Lentz)
@@ -390,6 +452,16 @@ void BallFlights::judge(gs_ev_jump *j)
     Parabola fit = fit_obs(in);
     // (the core leaves such detections out of its fit too: its outliers)
     if (j->n_outliers > 0) trim_contact_ends(in, fit);
+    if (retime_gaps(in, frame_dt(in), fit) > 0) {
+        // the flight's own clock: its acceleration and residual as re-timed
+        double a = std::hypot(fit.ax, fit.ay), n = (double)in.size();
+        j->a_px_s2 = a;
+        j->a_px_se_s2 = std::hypot(fit.ax * fit.ax_se, fit.ay * fit.ay_se) / a;
+        j->g_dir_deg = std::atan2(fit.ax, fit.ay) * 180.0 / M_PI;
+        j->q_m_per_px = opt_.g_m_s2 / a;
+        j->rms_px = fit.rms_px * std::sqrt(2.0 * (n - 3.0) / n);
+        j->n_samples = (uint32_t)in.size();
+    }
     FlightSize fs = measure(in, fit, j->a_px_s2);
     // The core's residual limit is a share of the size; a small ball's centroid
     // scatters more than that, so the clip's centre noise decides, then the core's
@@ -469,6 +541,96 @@ void BallFlights::judge(gs_ev_jump *j)
         j->accepted = false;
         j->reason = GS_REJ_NOT_PLANAR;
     }
+    // a ball moving in depth: its image's acceleration is not g's over its size (the
+    // parabola in the image may still fit a short arc)
+    if (j->accepted || j->reason == GS_REJ_LARGE_RESIDUAL || j->reason == GS_REJ_NOT_PLANAR) depth_flight(in, j);
+}
+
+// A ball moving in depth (toward a wall, back from it): its image's position from
+// the optical axis and its diameter both scale as 1/Z, so u = (x - cx) / d and
+// v = (y - cy) / d are its position in diameters whatever its depth and the focal
+// length; in free flight they follow a parabola of acceleration g / D along gravity
+// (an offset of the optical axis adds a term in Z, linear in time). Used only where
+// the size changes along the flight beyond its noise, and only while gravity lies in
+// the image's plane: Z (as 1/d) must not accelerate, else the plane's share of g is
+// less than g (a camera tilted toward the fall).
+int BallFlights::depth_flight(const std::vector<BallObs> &pts, gs_ev_jump *j) const
+{
+    const double cx = 0.5 * opt_.frame_w, cy = 0.5 * opt_.frame_h;
+    if (!(cx > 0.0 && cy > 0.0)) return 0;
+    std::vector<TrackPoint> uv, zz;
+    std::vector<double> ds;
+    double d_sum = 0.0;
+    for (const BallObs &o : pts) {
+        if (!(o.diameter_px > 0.0)) continue;
+        uv.push_back({o.t_s, (o.x_px - cx) / o.diameter_px, (o.y_px - cy) / o.diameter_px, 1.0});
+        ds.push_back(o.diameter_px);
+        d_sum += o.diameter_px;
+    }
+    const size_t n = uv.size();
+    if (n < opt_.core.min_samples || n < 7) return 0;
+    const double d_mean = d_sum / (double)n;
+    // a diameter's tenth: the sizes' scatter (a few per cent) times a few diameters off-axis
+    std::vector<bool> inl;
+    Parabola r = ransac_parabola(uv, 0.1, 300, inl, 1);
+    if (!r.ok) return 0;
+    // the inliers, and their relative depth d_mean / d (Z's motion and acceleration)
+    std::vector<TrackPoint> in;
+    for (size_t i = 0; i < n; i++)
+        if (inl[i]) {
+            in.push_back(uv[i]);
+            zz.push_back({uv[i].t_s, d_mean / ds[i], 0.0, 1.0});
+        }
+    if (in.size() < 7 || (double)in.size() < 0.75 * (double)n) return 0;
+    Parabola f = fit_parabola(in), z = fit_parabola(zz);
+    if (!f.ok || !z.ok) return 0;
+    double span = in.back().t_s - in.front().t_s;
+    double zmin = 1e300, zmax = -1e300;
+    for (const TrackPoint &q : zz) { zmin = std::min(zmin, q.x_px); zmax = std::max(zmax, q.x_px); }
+    // the depth's change along the flight (5 % or more), its trend eight standard
+    // errors clear of the sizes' scatter
+    double tm = 0.0, stt = 0.0;
+    for (const TrackPoint &q : zz) tm += q.t_s / (double)zz.size();
+    for (const TrackPoint &q : zz) stt += (q.t_s - tm) * (q.t_s - tm);
+    double dz = std::fabs(z.vx) * span, z_rms = z.rms_px * std::sqrt(2.0);  // (its rms_px pools z with zeros)
+    bool in_depth = dz > 0.05 && std::fabs(z.vx) > 8.0 * z_rms / std::sqrt(std::max(stt, 1e-12));
+    double a = std::hypot(f.ax, f.ay);
+    if (!(a > 0.0)) return 0;
+    double a_se = std::hypot(f.ax * f.ax_se, f.ay * f.ay_se) / a;
+    // Z's acceleration in diameters: f_px / d_mean times z's, with the longest lens
+    // assumed at twice the frame's longer side; its share of g tilts the plane
+    double f_max = 2.0 * std::max(opt_.frame_w, opt_.frame_h);
+    double a_z = f_max / d_mean * (std::fabs(z.ax) + 2.0 * z.ax_se);
+    double tilt_rel = std::sqrt(1.0 + (a_z / a) * (a_z / a)) - 1.0;
+    bool down = f.ay / a > std::cos(M_PI / 4.0);
+    if (debug())
+        std::fprintf(stderr, "      in depth: n=%zu of %zu, z %.3f..%.3f (change %.3f, rms %.4f) a=%.1f+-%.1f D/s^2 -> %.4f m; "
+                     "z accel %.3f+-%.3f /s^2 -> tilt bound %.3f\n", in.size(), n, zmin, zmax, dz, z.rms_px, a, a_se,
+                     opt_.g_m_s2 / a, z.ax, z.ax_se, tilt_rel);
+    if (!in_depth || !down) return 0;
+    double size_m = opt_.g_m_s2 / a;
+    double se_rel = std::hypot(a_se / a, tilt_rel / std::sqrt(3.0));
+    if (!(se_rel <= opt_.core.max_a_se_rel) || tilt_rel > 0.05 || size_m < opt_.core.size_min_m ||
+        size_m > opt_.core.size_max_m) {
+        // not measurable so; but gravity out of the plane only lowers the acceleration
+        // in it, so g / a bounds the size from above: a flight's size beyond it by three
+        // combined SEs is wrong
+        double rel = std::hypot(a_se / a, j->height_se_m / j->height_m);
+        if (j->accepted && j->height_m > size_m * (1.0 + 3.0 * rel)) {
+            if (debug()) std::fprintf(stderr, "      %.4f m is beyond the bound %.4f m\n", j->height_m, size_m);
+            j->accepted = false;
+            j->reason = GS_REJ_NOT_PLANAR;
+        }
+        return -1;
+    }
+    j->height_m = size_m;
+    j->height_se_m = size_m * se_rel;
+    j->size_px = d_mean;
+    j->q_m_per_px = size_m / d_mean;
+    j->rms_px = f.rms_px * d_mean;
+    j->accepted = true;
+    j->reason = GS_REJ_NONE;
+    return 1;
 }
 
 bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
@@ -476,6 +638,7 @@ bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
     std::vector<BallObs> pts = a0.pts;
     Parabola fit = fit_obs(pts);
     trim_contact_ends(pts, fit);
+    retime_gaps(pts, frame_dt(pts), fit);
     if (!fit.ok) return false;
     double amag = std::hypot(fit.ax, fit.ay);
     if (!(amag > 0)) return false;
@@ -526,6 +689,7 @@ bool BallFlights::flight_from_arc(int track, const Arc &a0, gs_ev_jump *j)
     else if (fs.not_planar)
         j->reason = GS_REJ_NOT_PLANAR;
     j->accepted = j->reason == GS_REJ_NONE;
+    if (j->accepted || j->reason == GS_REJ_LARGE_RESIDUAL || j->reason == GS_REJ_NOT_PLANAR) depth_flight(pts, j);
     if (pts.size() < 2u * c.min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
     (void)dt;
     return true;

@@ -17,6 +17,9 @@
 //  * the residual's limit: the core's share of the size, or the centre noise the
 //    clip's own detections show for a ball of this size when that is larger (a
 //    small ball's centroid is noisier than a fixed share of its size);
+//  * motion in depth: a ball whose image size follows its depth is measured in
+//    its own diameters ((x - cx) / d, (y - cy) / d are its position in diameters
+//    at any depth and focal length), where gravity's g / D is the acceleration;
 //  * flights the core cannot seed: the core starts a flight at an apex, so a
 //    ball dropped from rest (or one that leaves the frame before its apex) is
 //    found here, as a parabola over the track's detections between two breaks,
@@ -99,6 +102,10 @@ private:
     void close_arc(int track, TrackState &ts);
     FlightSize measure(const std::vector<BallObs> &pts, const Parabola &fit, double a_px_s2);
     bool flight_from_arc(int track, const Arc &a, gs_ev_jump *j);
+    // 1: measured in depth (j rewritten), -1: moving in depth but not measurable so
+    // (gravity out of the image's plane, too uncertain; j rejected when its size is
+    // beyond the bound g / a), 0: not moving in depth
+    int depth_flight(const std::vector<BallObs> &pts, gs_ev_jump *j) const;
     double frame_dt(const std::vector<BallObs> &pts) const;
     double centre_var_px2(double d_px) const;
     bool residual_ok(double rms_px, size_t n, double d_px) const;
