@@ -25,7 +25,8 @@ TOP = os.path.dirname(HERE)
 # name, file (under data/real), detector, extra args, truth
 #   truth kinds: ("size", lo_m, hi_m) the summary's size; ("none",) nothing accepted;
 #   ("jump", flight_s, tol_s, jump_m, tol_m) the pose jump; ("agree", rel) the tracks' sizes agree;
-#   ("reject_or", lo_m, hi_m) rejected, or else within the range; ("any",) robustness only
+#   ("reject_or", lo_m, hi_m) rejected, or else within the range; ("any",) robustness only;
+#   ("arcs_agree", rel) two accepted flights or more, every two within rel and three combined SEs
 CLIPS = [
     ("ameen", "bouncing_ball_ameen/bounceAmeen.avi", "ball", [], ("size", 0.0687 * 0.97, 0.0687 * 1.03)),
     ("kth_720p", "tennis_bounce_kth/single_ball_1-long_720p30.mp4", "ball", [], ("size", 0.0654 * 0.95, 0.0686 * 1.05)),
@@ -33,7 +34,7 @@ CLIPS = [
     ("table_3ftstrip", "tennis_drop_table_3ftstrip/tennis_ball_reference.mp4", "ball", [], ("size", 0.0621, 0.0720)),
     ("basketball", "basketball_freethrow_sideon/FreeThrow.mp4", "ball", [], ("size", 0.220, 0.257)),
     ("redball_portrait", "redball_drop_bounce_portrait/RedBall.mp4", "ball", [], ("any",)),
-    ("pinkball_portrait", "pinkball_toss_bounces_portrait/ball.mp4", "ball", [], ("any",)),
+    ("pinkball_portrait", "pinkball_toss_bounces_portrait/ball.mp4", "ball", [], ("arcs_agree", 0.08)),
     ("knobbyball", "knobbyball_vertical_toss_whiteboard/ball.MOV", "ball", [], ("any",)),
     ("juggling", "juggling_3balls_lowres/juggling_low_quality.mp4", "ball", [], ("agree", 0.05)),
     ("tilted_drop", "tennis_drop_blanket_portrait_tilted/h1_f1_r1.mp4", "ball", [], ("reject_or", 0.0654 * 0.95, 0.0686 * 1.05)),
@@ -91,6 +92,12 @@ def judge(r):
         ok = len(sizes) >= 2 and max(sizes) / min(sizes) - 1.0 <= truth[1]
         return "%s, sizes %s" % (n, ",".join(fmt_m(s) for s in sizes) or "null"), \
             "sizes agree %d %%" % round(100 * truth[1]), "ok" if ok else "MISS"
+    if kind == "arcs_agree":
+        fl = [(j["height_m"], j.get("height_se_m") or 0.0) for j in acc if j.get("height_m") is not None]
+        ok = len(fl) >= 2 and all(abs(a - b) <= 3.0 * (sa * sa + sb * sb) ** 0.5 and abs(a / b - 1.0) <= truth[1]
+                                  for i, (a, sa) in enumerate(fl) for (b, sb) in fl[i + 1:])
+        return "%s, flights %s" % (n, ",".join(fmt_m(a) for a, _ in fl) or "null"), \
+            "flights agree %d %%, 3 SE" % round(100 * truth[1]), "ok" if ok else "MISS"
     if kind == "jump":
         ft, ft_tol, jh, jh_tol = truth[1:]
         js = r["jumps"]
