@@ -65,7 +65,7 @@ static char *slurp(const char *path, size_t *len)
 
 /* Run GS_PROGRAM with args (NULL-terminated, without argv[0]). stdout_fd >= 0:
  * that descriptor becomes the child's stdout instead of a capture file. */
-static void run_fd(const char *const *args, int stdout_fd, run_result *r)
+static void run_io(const char *const *args, int stdin_fd, int stdout_fd, run_result *r)
 {
     char outp[256], errp[256];
     snprintf(outp, sizeof outp, "%s/run%03d.out", g_dir, g_seq);
@@ -78,6 +78,8 @@ static void run_fd(const char *const *args, int stdout_fd, run_result *r)
     argv[n] = NULL;
     posix_spawn_file_actions_t fa;
     posix_spawn_file_actions_init(&fa);
+    if (stdin_fd >= 0)
+        posix_spawn_file_actions_adddup2(&fa, stdin_fd, STDIN_FILENO);
     if (stdout_fd >= 0)
         posix_spawn_file_actions_adddup2(&fa, stdout_fd, STDOUT_FILENO);
     else
@@ -100,7 +102,9 @@ static void run_fd(const char *const *args, int stdout_fd, run_result *r)
     r->err = slurp(errp, &r->err_len);
 }
 
-static void run(const char *const *args, run_result *r) { run_fd(args, -1, r); }
+static void run_fd(const char *const *args, int stdout_fd, run_result *r) { run_io(args, -1, stdout_fd, r); }
+
+static void run(const char *const *args, run_result *r) { run_io(args, -1, -1, r); }
 
 static void run_free(run_result *r)
 {
@@ -175,7 +179,7 @@ static double field_of_last(const char *out, const char *event, const char *key)
 /* A ball resting, thrown N_THROWS times (rising 2.5 m/s, drifting 0.2 m/s) and
  * resting again, seen at FPS with +-0.3 px of deterministic noise. bad_line > 0:
  * that line's y field becomes "oops". */
-static void write_ball(const char *path, int bad_line)
+static void write_balls(const char *path, int bad_line, int n_throws)
 {
     FILE *f = fopen(path, "wb");
     TEST_ASSERT_NOT_NULL(f);
@@ -185,8 +189,8 @@ static void write_ball(const char *path, int bad_line)
     uint32_t rng = 12345u;
     int frame = 0, line = 2;
     double x = 400.0, y0 = 900.0;
-    for (int throw_i = 0; throw_i <= N_THROWS; throw_i++) {
-        double flight = throw_i < N_THROWS ? 2.0 * v_up / a_px : 0.0;
+    for (int throw_i = 0; throw_i <= n_throws; throw_i++) {
+        double flight = throw_i < n_throws ? 2.0 * v_up / a_px : 0.0;
         double t_rest = 1.0, t0 = frame / FPS;
         for (;;) {
             double t = frame / FPS - t0, y = y0, xx = x;
@@ -212,6 +216,8 @@ static void write_ball(const char *path, int bad_line)
     }
     TEST_ASSERT_EQUAL_INT(0, fclose(f));
 }
+
+static void write_ball(const char *path, int bad_line) { write_balls(path, bad_line, N_THROWS); }
 
 /* ---- tests -------------------------------------------------------------- */
 
@@ -500,6 +506,80 @@ void test_full_disk_exits_3(void)
     run_free(&r);
 }
 
+/* `replay --keypoints /dev/stdin` fed through a pipe by a child: read frame by frame */
+static void run_piped(const char *path, run_result *r)
+{
+    int fds[2];
+    TEST_ASSERT_EQUAL_INT(0, pipe(fds));
+    pid_t feeder = fork();
+    TEST_ASSERT_TRUE(feeder >= 0);
+    if (feeder == 0) {
+        close(fds[0]);
+        int in = open(path, O_RDONLY);
+        char buf[1 << 14];
+        ssize_t n;
+        while (in >= 0 && (n = read(in, buf, sizeof buf)) > 0)
+            if (write(fds[1], buf, (size_t)n) != n)
+                break;
+        _exit(0);
+    }
+    close(fds[1]);
+    run_io((const char *[]){"replay", "--keypoints", "/dev/stdin", "--config", g_cfg, NULL}, fds[0], -1, r);
+    close(fds[0]);
+    int status;
+    TEST_ASSERT_EQUAL_INT(feeder, waitpid(feeder, &status, 0));
+}
+
+/* A file is read ahead in a second thread in batches, a pipe frame by frame: the
+ * same events, the same first error (here after several batches), the same exits. */
+void test_read_ahead_gives_what_a_pipe_gives(void)
+{
+    enum { THROWS = 24, BAD_LINE = 2000 }; /* ~91 frames a throw: past the read-ahead's slots twice */
+    char good[256], bad[256];
+    snprintf(good, sizeof good, "%s/balls_long.csv", g_dir);
+    snprintf(bad, sizeof bad, "%s/balls_long_bad.csv", g_dir);
+    write_balls(good, 0, THROWS);
+    write_balls(bad, BAD_LINE, THROWS);
+
+    run_result f, p;
+    run((const char *[]){"replay", "--keypoints", good, "--config", g_cfg, NULL}, &f);
+    run_piped(good, &p);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, f.code, f.err);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, p.code, p.err);
+    TEST_ASSERT_EQUAL_INT(THROWS, count_substr(f.out, "\"event\":\"jump\""));
+    TEST_ASSERT_EQUAL_UINT64(p.out_len, f.out_len);
+    TEST_ASSERT_EQUAL_MEMORY(p.out, f.out, f.out_len);
+    run_free(&f);
+    run_free(&p);
+
+    run((const char *[]){"replay", "--keypoints", bad, "--config", g_cfg, NULL}, &f);
+    run_piped(bad, &p);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, f.code, f.err);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, p.code, p.err);
+    char want[400];
+    snprintf(want, sizeof want, "gravscale: %s:%d: field 'y': not a number ('oops')\n", bad, BAD_LINE);
+    TEST_ASSERT_EQUAL_STRING(want, f.err);
+    snprintf(want, sizeof want, "gravscale: /dev/stdin:%d: field 'y': not a number ('oops')\n", BAD_LINE);
+    TEST_ASSERT_EQUAL_STRING(want, p.err);
+    int jumps = count_substr(f.out, "\"event\":\"jump\"");
+    TEST_ASSERT_TRUE(jumps >= 20 && jumps < THROWS); /* the throws before line 2000, no summary */
+    TEST_ASSERT_EQUAL_INT(0, count_substr(f.out, "\"summary\""));
+    TEST_ASSERT_EQUAL_UINT64(p.out_len, f.out_len);
+    TEST_ASSERT_EQUAL_MEMORY(p.out, f.out, f.out_len);
+    run_free(&f);
+    run_free(&p);
+
+    /* the output closed while the reader is still ahead in the file: exit 3, quietly */
+    int fds[2];
+    TEST_ASSERT_EQUAL_INT(0, pipe(fds));
+    close(fds[0]);
+    run_fd((const char *[]){"replay", "--keypoints", good, "--config", g_cfg, NULL}, fds[1], &f);
+    close(fds[1]);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(3, f.code, f.err);
+    TEST_ASSERT_EQUAL_STRING("", f.err);
+    run_free(&f);
+}
+
 /* AlphaPose (.json picked by its name) and an OpenPose folder: times from --fps */
 void test_json_inputs_with_fps(void)
 {
@@ -575,6 +655,7 @@ int main(void)
     RUN_TEST(test_trace_file);
     RUN_TEST(test_closed_pipe_exits_3_quietly);
     RUN_TEST(test_full_disk_exits_3);
+    RUN_TEST(test_read_ahead_gives_what_a_pipe_gives);
     int fails = UNITY_END();
     rm_tree(g_dir);
     return fails;

@@ -15,6 +15,7 @@
 #include "gs_kpread.h"
 #include "gs_out.h"
 #include "gs_profile.h"
+#include "kp_ahead.h"
 
 /* Declared in main.c as well (no app header yet). */
 int gs_cmd_replay(int argc, char **argv);
@@ -220,14 +221,17 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void progress_tick(progress *pg, const gs_kpread *r, uint64_t frames)
+static void progress_tick(progress *pg, const gs_kpread *r, const kp_ahead *ahead, uint64_t frames)
 {
     double t = now_s();
     if (t < pg->next_s)
         return;
     pg->next_s = t + 0.25; /* at most four updates a second */
     uint64_t done, total;
-    gs_kpread_progress(r, &done, &total);
+    if (ahead)
+        kp_ahead_progress(ahead, &done, &total);
+    else
+        gs_kpread_progress(r, &done, &total);
     if (total > 0)
         fprintf(stderr, "\rgravscale: %llu frames (%3.0f%%)", (unsigned long long)frames,
                 100.0 * (double)done / (double)total);
@@ -378,18 +382,26 @@ int gs_cmd_replay(int argc, char **argv)
     uint64_t frames = 0;
     for (size_t i = 0; i < npre && !app.out.err; i++, frames++)
         push_frame(&app, pl, layout, &pre[i]);
+    kp_ahead *ahead = NULL;
     if (ks == GS_KPR_FRAME) {
-        gs_kpframe *f = &pre[0];
+        /* a file is read ahead in a second thread; a pipe or a terminal frame by frame, so
+         * that each frame's events leave as soon as its line arrives */
+        uint64_t done_bytes, total_bytes;
+        gs_kpread_progress(rd, &done_bytes, &total_bytes);
+        if (total_bytes > 0)
+            ahead = kp_ahead_start(rd);
         while (!app.out.err) {
-            ks = gs_kpread_next(rd, f, &kerr);
+            const gs_kpframe *f = &pre[0];
+            ks = ahead ? kp_ahead_next(ahead, &f, &kerr) : gs_kpread_next(rd, &pre[0], &kerr);
             if (ks != GS_KPR_FRAME)
                 break;
             push_frame(&app, pl, layout, f);
             frames++;
             if (pg.on && (frames & 4095u) == 0)
-                progress_tick(&pg, rd, frames);
+                progress_tick(&pg, rd, ahead, frames);
         }
     }
+    kp_ahead_stop(ahead);
     progress_clear(&pg);
     if (app.out.err) {
         rc = output_status(&app);

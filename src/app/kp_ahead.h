@@ -1,0 +1,36 @@
+/* kp_ahead.h - a keypoint file read ahead in a second thread: the reader parses
+ * the next batches while the caller runs the pipeline on the current one, so a
+ * replay of a large file takes the longer of the two, not their sum. Frames,
+ * the end and the first error come out exactly as gs_kpread_next gives them. */
+#ifndef GS_KP_AHEAD_H
+#define GS_KP_AHEAD_H
+
+#include <stdint.h>
+
+#include "gs_kpread.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct kp_ahead kp_ahead;
+
+/* Starts reading r ahead (r is the thread's until kp_ahead_stop). NULL when a
+ * thread or its buffers cannot be had: the caller then reads r itself. */
+kp_ahead *kp_ahead_start(gs_kpread *r);
+
+/* The next frame (valid until the next call), or the reader's end/error status
+ * with err filled as gs_kpread_next fills it. */
+gs_kpr_status kp_ahead_next(kp_ahead *q, const gs_kpframe **f, gs_kpread_error *err);
+
+/* Bytes of the file read by the frames handed out so far, and the file's size. */
+void kp_ahead_progress(const kp_ahead *q, uint64_t *done_bytes, uint64_t *total_bytes);
+
+/* Stops the reader (it may be mid-file: the caller gave up), joins it, frees q. */
+void kp_ahead_stop(kp_ahead *q);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
