@@ -36,12 +36,21 @@
 /* two doubles, for the hot loops over a cached window (element-wise IEEE, as scalars) */
 typedef double gs_v2d __attribute__((vector_size(16)));
 typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lanes: -1 true, 0 false */
-/* lanes i and j of the four in (a, b): GCC's and clang's spellings of the same shuffle */
-#ifdef __clang__
-#define GS_V2_PICK(a, b, i, j) __builtin_shufflevector(a, b, i, j)
-#else
-#define GS_V2_PICK(a, b, i, j) __builtin_shuffle(a, b, (gs_v2l){i, j})
 #endif
+
+/* x86-64 hosts whose CPU has AVX2 take the loops over a fully usable cached window
+ * four samples to a register: the same IEEE operations lane by lane, no fused
+ * multiply-add (not enabled), sums still added sample after sample */
+#if GS_FIT_FAST && defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define GS_FIT_AVX2 1
+#define GS_AVX2 __attribute__((target("avx2,popcnt")))
+static bool fit_avx2(void)
+{
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
+}
+#else
+#define GS_FIT_AVX2 0
 #endif
 
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
@@ -317,10 +326,10 @@ typedef struct {
     gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
-    gs_real *exy;             /* fast double builds: ... and their x, y residuals, side by side */
+    gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
     uint32_t *key;            /* the median's selection scratch */
     float *med_key;           /* fast builds: the last median's squared residual, as a float */
-    gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y (3 rows of m) */
+    gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y, w (4 rows of m) */
     struct gs_wlast *last;    /* fast builds: the last reweighting's sums, solved in full only at the end */
 } gs_win;
 
@@ -497,6 +506,164 @@ static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, f
 }
 #endif
 
+#if GS_FIT_AVX2
+/* The residuals from p of a fully usable cached window, four samples at a time: each
+ * sample's x, y residual and squared norm to the rows and its float to the keys, as
+ * median_resid's loop. Returns how many samples it did (the rest: fewer than 4). */
+GS_AVX2 static uint32_t resid_rows_avx2(const gs_win *wn, const gs_par *p)
+{
+    const double *t = wn->soa, *x = t + GS_FIT_CACHE, *y = t + 2u * GS_FIT_CACHE;
+    __m256d c0 = _mm256_set1_pd(p->c[0]), c1 = _mm256_set1_pd(p->c[1]), c2 = _mm256_set1_pd(p->c[2]);
+    __m256d c3 = _mm256_set1_pd(p->c[3]), c4 = _mm256_set1_pd(p->c[4]), c5 = _mm256_set1_pd(p->c[5]);
+    uint32_t i;
+    for (i = 0; i + 4u <= wn->count; i += 4u) {
+        __m256d tau = _mm256_loadu_pd(&t[i]);
+        __m256d ex = _mm256_sub_pd(_mm256_loadu_pd(&x[i]),
+                                   _mm256_add_pd(c0, _mm256_mul_pd(tau, _mm256_add_pd(c1, _mm256_mul_pd(tau, c2)))));
+        __m256d ey = _mm256_sub_pd(_mm256_loadu_pd(&y[i]),
+                                   _mm256_add_pd(c3, _mm256_mul_pd(tau, _mm256_add_pd(c4, _mm256_mul_pd(tau, c5)))));
+        __m256d r2 = _mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey));
+        _mm256_storeu_pd(&wn->r2[i], r2);
+        _mm256_storeu_pd(&wn->exy[i], ex);
+        _mm256_storeu_pd(&wn->exy[GS_FIT_CACHE + i], ey);
+        _mm_storeu_ps((float *)(void *)&wn->key[i], _mm256_cvtpd_ps(r2));
+    }
+    return i;
+}
+
+/* How many of the four squared residuals from (c0..c5) of samples j..j+3 lie below T. */
+GS_AVX2 static inline uint32_t below4_avx2(const double *t, const double *x, const double *y, uint32_t j,
+                                           const __m256d c[6], __m256d vT)
+{
+    __m256d tau = _mm256_loadu_pd(&t[j]);
+    __m256d ex = _mm256_sub_pd(_mm256_loadu_pd(&x[j]),
+                               _mm256_add_pd(c[0], _mm256_mul_pd(tau, _mm256_add_pd(c[1], _mm256_mul_pd(tau, c[2])))));
+    __m256d ey = _mm256_sub_pd(_mm256_loadu_pd(&y[j]),
+                               _mm256_add_pd(c[3], _mm256_mul_pd(tau, _mm256_add_pd(c[4], _mm256_mul_pd(tau, c[5])))));
+    __m256d r2 = _mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey));
+    return (uint32_t)__builtin_popcount((unsigned)_mm256_movemask_pd(_mm256_cmp_pd(r2, vT, _CMP_LT_OQ)));
+}
+
+/* median_below_cached's count, eight samples at a time (then four, then one): the
+ * same verdict, which only counts. */
+GS_AVX2 static bool median_below_avx2(const gs_win *wn, const gs_par *p, double T, uint32_t need, uint32_t room)
+{
+    const double *t = wn->soa, *x = t + GS_FIT_CACHE, *y = t + 2u * GS_FIT_CACHE;
+    __m256d c[6], vT = _mm256_set1_pd(T);
+    uint32_t m = wn->m, less = 0, j = 0, k;
+    for (k = 0; k < 6u; k++) {
+        c[k] = _mm256_set1_pd(p->c[k]);
+    }
+    for (; j + 8u <= m; j += 8u) {
+        less += below4_avx2(t, x, y, j, c, vT) + below4_avx2(t, x, y, j + 4u, c, vT);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 8u - less > room) {
+            return false;
+        }
+    }
+    if (j + 4u <= m) {
+        less += below4_avx2(t, x, y, j, c, vT);
+        j += 4u;
+    }
+    for (; j < m; j++) {
+        double tau = t[j];
+        double ex = x[j] - (p->c[0] + tau * (p->c[1] + tau * p->c[2]));
+        double ey = y[j] - (p->c[3] + tau * (p->c[4] + tau * p->c[5]));
+        less += (uint32_t)(ex * ex + ey * ey < T);
+    }
+    return less >= need;
+}
+
+/* Adds the four samples' (a, b, c, d) to acc's four sums, sample after sample. */
+GS_AVX2 static inline __m256d add4_avx2(__m256d acc, __m256d a, __m256d b, __m256d c, __m256d d)
+{
+    __m256d ab02 = _mm256_unpacklo_pd(a, b), ab13 = _mm256_unpackhi_pd(a, b);
+    __m256d cd02 = _mm256_unpacklo_pd(c, d), cd13 = _mm256_unpackhi_pd(c, d);
+    acc = _mm256_add_pd(acc, _mm256_permute2f128_pd(ab02, cd02, 0x20));
+    acc = _mm256_add_pd(acc, _mm256_permute2f128_pd(ab13, cd13, 0x20));
+    acc = _mm256_add_pd(acc, _mm256_permute2f128_pd(ab02, cd02, 0x31));
+    return _mm256_add_pd(acc, _mm256_permute2f128_pd(ab13, cd13, 0x31));
+}
+
+/* wsums_cached's IRLS step over a fully usable cached window, four samples at a time:
+ * the Tukey weights from the median's residuals, the same products, each sum taken in
+ * sample order. A rejected sample's lanes are zeroed and add +0 or -0, which leaves a
+ * sum as it is (a sum that starts at +0 is never -0). s: g0..g4, bx0..2, by0..2, eex,
+ * eey, as wsums_cached's; *word: the kept bits of the unfinished word. Returns how
+ * many samples it did (the rest: fewer than 4). */
+GS_AVX2 static uint32_t wsums_tukey_avx2(const gs_win *wn, double cut, uint32_t *keep, const double *r2,
+                                         double s[13], uint32_t *n_out, uint32_t *word_io)
+{
+    const double *t = wn->soa, *wp = wn->soa + 3u * GS_FIT_CACHE, *ex_row = wn->exy, *ey_row = wn->exy + GS_FIT_CACHE;
+    __m256d vcut = _mm256_set1_pd(cut), one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
+    __m256d g = zero, b01 = zero, b2e = zero; /* (g0 g1 g2 g3), (bx0 by0 bx1 by1), (bx2 by2 eex eey) */
+    double g4 = 0.0;
+    uint32_t n = 0, word = 0, i;
+    for (i = 0; i + 4u <= wn->count; i += 4u) {
+        __m256d r = _mm256_sqrt_pd(_mm256_loadu_pd(&r2[i]));
+        __m256d in = _mm256_cmp_pd(r, vcut, _CMP_LT_OQ);
+        __m256d u = _mm256_div_pd(r, vcut), w, ex, ey, tau, wt1, wt2, wt3, wt4, wx, wy;
+        unsigned bits;
+        u = _mm256_sub_pd(one, _mm256_mul_pd(u, u));
+        w = _mm256_cvtps_pd(_mm256_cvtpd_ps(_mm256_mul_pd(_mm256_loadu_pd(&wp[i]), _mm256_mul_pd(u, u))));
+        in = _mm256_and_pd(in, _mm256_cmp_pd(w, zero, _CMP_GT_OQ));
+        bits = (unsigned)_mm256_movemask_pd(in);
+        if (((i + 4u) & 31u) == 0u) {
+            keep[i >> 5] = word | (bits << (i & 31u)); /* a whole word */
+            word = 0;
+        } else {
+            word |= bits << (i & 31u);
+        }
+        if (bits == 0u) {
+            continue; /* nothing to add */
+        }
+        n += (uint32_t)__builtin_popcount(bits);
+        w = _mm256_and_pd(w, in);
+        ex = _mm256_and_pd(_mm256_loadu_pd(&ex_row[i]), in);
+        ey = _mm256_and_pd(_mm256_loadu_pd(&ey_row[i]), in);
+        tau = _mm256_loadu_pd(&t[i]);
+        wt1 = _mm256_mul_pd(w, tau);
+        wt2 = _mm256_mul_pd(wt1, tau);
+        wt3 = _mm256_mul_pd(wt2, tau);
+        wt4 = _mm256_mul_pd(wt3, tau);
+        wx = _mm256_mul_pd(w, ex);
+        wy = _mm256_mul_pd(w, ey);
+        g = add4_avx2(g, w, wt1, wt2, wt3);
+        b01 = add4_avx2(b01, wx, wy, _mm256_mul_pd(wt1, ex), _mm256_mul_pd(wt1, ey));
+        b2e = add4_avx2(b2e, _mm256_mul_pd(wt2, ex), _mm256_mul_pd(wt2, ey), _mm256_mul_pd(wx, ex),
+                        _mm256_mul_pd(wy, ey));
+        {
+            __m128d lo = _mm256_castpd256_pd128(wt4), hi = _mm256_extractf128_pd(wt4, 1);
+            g4 += _mm_cvtsd_f64(lo);
+            g4 += _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo));
+            g4 += _mm_cvtsd_f64(hi);
+            g4 += _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi));
+        }
+    }
+    {
+        double v[12];
+        _mm256_storeu_pd(&v[0], g);
+        _mm256_storeu_pd(&v[4], b01);
+        _mm256_storeu_pd(&v[8], b2e);
+        s[0] = v[0], s[1] = v[1], s[2] = v[2], s[3] = v[3], s[4] = g4;
+        s[5] = v[4], s[6] = v[6], s[7] = v[8];    /* bx0 bx1 bx2 */
+        s[8] = v[5], s[9] = v[7], s[10] = v[9];   /* by0 by1 by2 */
+        s[11] = v[10], s[12] = v[11];             /* eex eey */
+    }
+    if (i == wn->count && (i & 31u) != 0u) {
+        /* the last word, part filled: bits past count keep their values */
+        uint32_t mask = (1u << (i & 31u)) - 1u;
+        keep[i >> 5] = (keep[i >> 5] & ~mask) | word;
+        word = 0;
+    }
+    *n_out = n;
+    *word_io = word;
+    return i;
+}
+#endif
+
 /* Median residual norm of the usable samples: the lower median of the squared
  * residuals as floats (squares order like norms: one sqrt for the median). The
  * keys sharing a prefix go to the buffer for select_key; while more than
@@ -519,10 +686,15 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
         uint32_t n = 0;
 #if defined(__GNUC__)
         if (!GS_REAL_IS_FLOAT && wn->m == wn->count) {
-            /* every sample usable: the rows of median_below_cached, two at a time */
+            /* every sample usable: the rows of median_below_cached, four or two at a time */
             const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
             gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5};
-            for (i = 0; i + 1u < wn->count; i += 2u) {
+#if GS_FIT_AVX2
+            i = fit_avx2() ? resid_rows_avx2(wn, p) : 0u;
+#else
+            i = 0;
+#endif
+            for (; i + 1u < wn->count; i += 2u) {
                 gs_v2d tau, vx, vy, ex, ey, r2;
                 float f0, f1;
                 memcpy(&tau, &t[i], sizeof tau);
@@ -532,11 +704,8 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 ey = vy - (v3 + tau * (v4 + tau * v5));
                 r2 = ex * ex + ey * ey;
                 memcpy(&wn->r2[i], &r2, sizeof r2);
-                {
-                    gs_v2d e0 = GS_V2_PICK(ex, ey, 0, 2), e1 = GS_V2_PICK(ex, ey, 1, 3);
-                    memcpy(&wn->exy[2u * i], &e0, sizeof e0);
-                    memcpy(&wn->exy[2u * i + 2u], &e1, sizeof e1);
-                }
+                memcpy(&wn->exy[i], &ex, sizeof ex);
+                memcpy(&wn->exy[GS_FIT_CACHE + i], &ey, sizeof ey);
                 f0 = (float)r2[0];
                 f1 = (float)r2[1];
                 memcpy(&wn->key[i], &f0, sizeof f0);
@@ -553,8 +722,8 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 gs_real r2 = ex * ex + ey * ey;
                 float f = (float)r2;
                 wn->r2[i] = r2;
-                wn->exy[2u * i] = ex;
-                wn->exy[2u * i + 1u] = ey;
+                wn->exy[i] = ex;
+                wn->exy[GS_FIT_CACHE + i] = ey;
                 memcpy(&wn->key[n++], &f, sizeof f);
             }
         }
@@ -666,6 +835,11 @@ static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key
     gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
     double T = below_key(med_key);
     uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
+#if GS_FIT_AVX2
+    if (fit_avx2()) {
+        return median_below_avx2(wn, p, T, need, room);
+    }
+#endif
 #if defined(__GNUC__)
     gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5}, vT = {T, T};
     for (; j + 3u < m; j += 4u) {
@@ -824,6 +998,19 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
 #if defined(__GNUC__)
     gs_v2d p0 = {base->c[0], base->c[3]}, p1 = {base->c[1], base->c[4]}, p2 = {base->c[2], base->c[5]};
     gs_v2d ee = {g0, g0}, v0 = ee, v1 = ee, v2 = ee;
+    i = 0;
+#if GS_FIT_AVX2
+    if (mode == W_TUKEY && r2 && wn->m == wn->count && fit_avx2()) {
+        /* the loop below does the last few */
+        double s[13];
+        i = wsums_tukey_avx2(wn, cut, keep, r2, s, &n, &word);
+        g0 = s[0], g1 = s[1], g2 = s[2], g3 = s[3], g4 = s[4];
+        v0 = (gs_v2d){s[5], s[8]};
+        v1 = (gs_v2d){s[6], s[9]};
+        v2 = (gs_v2d){s[7], s[10]};
+        ee = (gs_v2d){s[11], s[12]};
+    } else
+#endif
     if (mode == W_TUKEY && r2) {
         /* an IRLS step: the residuals from model (= base) the median left, 32 samples a word */
         uint32_t i0;
@@ -851,7 +1038,7 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
                 wr = (gs_real)w;
                 word |= 1u << (i - i0);
                 wv = (gs_v2d){wr, wr};
-                memcpy(&e, &wn->exy[2u * i], sizeof e);
+                e = (gs_v2d){wn->exy[i], wn->exy[GS_FIT_CACHE + i]};
                 ee += wv * e * e;
                 g0 += wr;
                 v0 += wv * e;
@@ -873,8 +1060,6 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
             keep[i0 >> 5] = (keep[i0 >> 5] & ~mask) | word;
         }
         i = wn->count; /* the general loop below has nothing left */
-    } else {
-        i = 0;
     }
 #else
     i = 0;
@@ -1375,6 +1560,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
                 wn->soa[n] = wn->cache[i].tau;
                 wn->soa[GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[0];
                 wn->soa[2u * GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[1];
+                wn->soa[3u * GS_FIT_CACHE + n] = (gs_real)wn->cache[i].w;
                 n++;
             }
         }
@@ -1406,7 +1592,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     uint32_t key[GS_FIT_FAST ? 2u * GS_FIT_CACHE : 1u]; /* the keys, and select_near's few */
 #if GS_FIT_FAST
     float med_key = 0.0f;
-    gs_real soa[GS_REAL_IS_FLOAT ? 1u : 3u * GS_FIT_CACHE];
+    gs_real soa[GS_REAL_IS_FLOAT ? 1u : 4u * GS_FIT_CACHE];
     gs_real exy[2u * GS_FIT_CACHE];
     gs_wlast last;
 #endif
