@@ -557,6 +557,9 @@ static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, f
 static const int64_t lanes64[8] = {-1, -1, -1, -1, 0, 0, 0, 0};
 static const int32_t lanes32[8] = {-1, -1, -1, -1, 0, 0, 0, 0};
 #define GS_LANES64(n) _mm256_loadu_si256((const __m256i *)(const void *)&lanes64[4u - (n)])
+/* the window's rows as doubles: the kernels below run only where gs_real is double (their
+ * callers test GS_REAL_IS_FLOAT), the float build compiles them as dead code */
+#define GS_D(rows) ((double *)(void *)(rows))
 #define GS_LANES32(n) _mm_loadu_si128((const __m128i *)(const void *)&lanes32[4u - (n)])
 
 /* The parabola's residuals of four samples of a fully usable cached window (lanes
@@ -564,7 +567,7 @@ static const int32_t lanes32[8] = {-1, -1, -1, -1, 0, 0, 0, 0};
 GS_AVX2 static inline __m256d resid4_avx2(const gs_win *wn, const __m256d c[6], uint32_t i, __m256i lanes,
                                           __m256d *ex, __m256d *ey)
 {
-    const double *t = wn->soa, *x = t + GS_FIT_CACHE, *y = t + 2u * GS_FIT_CACHE;
+    const double *t = GS_D(wn->soa), *x = t + GS_FIT_CACHE, *y = t + 2u * GS_FIT_CACHE;
     __m256d tau = _mm256_maskload_pd(&t[i], lanes);
     *ex = _mm256_sub_pd(_mm256_maskload_pd(&x[i], lanes),
                         _mm256_add_pd(c[0], _mm256_mul_pd(tau, _mm256_add_pd(c[1], _mm256_mul_pd(tau, c[2])))));
@@ -592,17 +595,17 @@ GS_AVX2 static void resid_rows_avx2(const gs_win *wn, const gs_par *p)
     par_lanes_avx2(p, c);
     for (i = 0; i + 4u <= wn->count; i += 4u) {
         r2 = resid4_avx2(wn, c, i, GS_LANES64(4u), &ex, &ey);
-        _mm256_storeu_pd(&wn->r2[i], r2);
-        _mm256_storeu_pd(&wn->exy[i], ex);
-        _mm256_storeu_pd(&wn->exy[GS_FIT_CACHE + i], ey);
+        _mm256_storeu_pd(&GS_D(wn->r2)[i], r2);
+        _mm256_storeu_pd(&GS_D(wn->exy)[i], ex);
+        _mm256_storeu_pd(&GS_D(wn->exy)[GS_FIT_CACHE + i], ey);
         _mm_storeu_ps((float *)(void *)&wn->key[i], _mm256_cvtpd_ps(r2));
     }
     if (i < wn->count) {
         __m256i lanes = GS_LANES64(wn->count - i);
         r2 = resid4_avx2(wn, c, i, lanes, &ex, &ey);
-        _mm256_maskstore_pd(&wn->r2[i], lanes, r2);
-        _mm256_maskstore_pd(&wn->exy[i], lanes, ex);
-        _mm256_maskstore_pd(&wn->exy[GS_FIT_CACHE + i], lanes, ey);
+        _mm256_maskstore_pd(&GS_D(wn->r2)[i], lanes, r2);
+        _mm256_maskstore_pd(&GS_D(wn->exy)[i], lanes, ex);
+        _mm256_maskstore_pd(&GS_D(wn->exy)[GS_FIT_CACHE + i], lanes, ey);
         _mm_maskstore_ps((float *)(void *)&wn->key[i], GS_LANES32(wn->count - i), _mm256_cvtpd_ps(r2));
     }
 }
@@ -661,12 +664,12 @@ GS_AVX2 static inline double add_lanes_avx2(double sum, __m256d v)
  * the Tukey weights from the median's residuals, the same products, each sum taken in
  * sample order. A rejected sample's lanes are zeroed and add +0 or -0, which leaves a
  * sum as it is (a sum that starts at +0 is never -0). s: g0..g4, bx0..2, by0..2, eex,
- * eey; the kept bits to keep (bits past count keep their values). Returns the samples
- * kept. */
-GS_AVX2 static uint32_t wsums_tukey_avx2(const gs_win *wn, double cut, uint32_t *keep, const double *r2,
-                                         double s[13])
+ * eey; the kept bits to keep (bits past count keep their values). The residuals are
+ * the median's (wn->r2, wn->exy). Returns the samples kept. */
+GS_AVX2 static uint32_t wsums_tukey_avx2(const gs_win *wn, double cut, uint32_t *keep, double s[13])
 {
-    const double *t = wn->soa, *wp = wn->soa + 3u * GS_FIT_CACHE, *ex_row = wn->exy, *ey_row = wn->exy + GS_FIT_CACHE;
+    const double *r2 = GS_D(wn->r2);
+    const double *t = GS_D(wn->soa), *wp = GS_D(wn->soa) + 3u * GS_FIT_CACHE, *ex_row = GS_D(wn->exy), *ey_row = GS_D(wn->exy) + GS_FIT_CACHE;
     __m256d vcut = _mm256_set1_pd(cut), one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
     __m256d g = zero, b01 = zero, b2e = zero; /* (g0 g1 g2 g3), (bx0 by0 bx1 by1), (bx2 by2 eex eey) */
     double g4 = 0.0, v[12];
@@ -721,7 +724,7 @@ GS_AVX2 static uint32_t wsums_tukey_avx2(const gs_win *wn, double cut, uint32_t 
  * sample order. */
 GS_AVX2 static double tukey_loss_avx2(const gs_win *wn, const gs_par *p, double cut)
 {
-    const double *wp = wn->soa + 3u * GS_FIT_CACHE;
+    const double *wp = GS_D(wn->soa) + 3u * GS_FIT_CACHE;
     __m256d c[6], vcut = _mm256_set1_pd(cut), one = _mm256_set1_pd(1.0), ex, ey;
     double loss = 0.0;
     uint32_t i;
@@ -1089,7 +1092,7 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
 #if GS_FIT_AVX2
     if (mode == W_TUKEY && r2 && wn->m == wn->count && fit_avx2()) {
         double s[13];
-        n = wsums_tukey_avx2(wn, cut, keep, r2, s);
+        n = wsums_tukey_avx2(wn, cut, keep, s); /* r2 is the median's: wn->r2 */
         i = wn->count;
         g0 = s[0], g1 = s[1], g2 = s[2], g3 = s[3], g4 = s[4];
         v0 = (gs_v2d){s[5], s[8]};
