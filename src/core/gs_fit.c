@@ -312,7 +312,7 @@ typedef struct {
 } gs_fsamp;
 
 /* Window samples unpacked on the stack by a fast build (2.3 KB with their residuals
- * and keys where gs_real is float, 20 KB in double) */
+ * and keys where gs_real is float, 22 KB in double) */
 #define GS_FIT_CACHE (GS_REAL_IS_FLOAT ? 64u : 256u)
 /* Fast builds: LMS triples already drawn, one bit each, for windows with at most this many */
 #define GS_FIT_SEEN_BITS 4096u
