@@ -701,6 +701,52 @@ static void test_robust_exact_data_keeps_everything(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-3, 100.0, res.a_px_s2);
 }
 
+/* IRLS over windows of every length from 5 to 70 samples, gross outliers at the first
+ * sample, around the 32-sample word boundary and at the last: exactly they are rejected,
+ * and keep's bits past the window (the rest of its last word, the next words) are left
+ * as they were. */
+static void test_robust_keep_bits_every_length(void)
+{
+    gs_ring r;
+    gs_fit_result res;
+    static uint32_t keep[RING_CAP / 32];
+    const uint32_t pattern = 0xA5C3965Au;
+    uint32_t count, i;
+    rng_seed(777);
+    for (count = 5; count <= 70; count++) {
+        bool out[70] = {false};
+        uint32_t n_out = 0, words = (count + 31u) / 32u;
+        out[0] = count >= 9;
+        out[count - 1] = true;
+        if (count > 33) {
+            out[31] = out[32] = true;
+        }
+        TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_init(&r, ring_store, RING_CAP));
+        for (i = 0; i < count; i++) {
+            double tt = i / 60.0;
+            double x = 300.0 + 50.0 * tt + 0.3 * rng_gauss() + (out[i] ? 80.0 : 0.0);
+            double y = 700.0 - 500.0 * tt + 0.5 * 1500.0 * tt * tt + 0.3 * rng_gauss() - (out[i] ? 60.0 : 0.0);
+            gs_sample_full s = mk_sample(50.0 + tt, x, y, rng_range(0.5, 1.0));
+            gs_ring_push(&r, &s);
+            n_out += out[i] ? 1u : 0u;
+        }
+        for (i = 0; i < RING_CAP / 32; i++) {
+            keep[i] = pattern;
+        }
+        TEST_ASSERT_EQUAL_INT(GS_OK, gs_fit_robust(&r, 0, count, GS_FIT_IRLS, 0.5f, keep, &res));
+        TEST_ASSERT_EQUAL_UINT32(count - n_out, res.n);
+        for (i = 0; i < count; i++) {
+            TEST_ASSERT_EQUAL_INT(!out[i], gs_fit_kept(keep, i));
+        }
+        for (i = count; i < 32u * words; i++) {
+            TEST_ASSERT_EQUAL_INT((pattern >> (i & 31u)) & 1u, gs_fit_kept(keep, i));
+        }
+        for (i = words; i < RING_CAP / 32; i++) {
+            TEST_ASSERT_EQUAL_HEX32(pattern, keep[i]);
+        }
+    }
+}
+
 /* ---- degenerate input ------------------------------------------------------------------------ */
 
 typedef struct {
@@ -955,6 +1001,7 @@ int main(void)
     RUN_TEST(test_robust_gross_outliers);
     RUN_TEST(test_robust_without_outliers_matches_plain);
     RUN_TEST(test_robust_exact_data_keeps_everything);
+    RUN_TEST(test_robust_keep_bits_every_length);
     RUN_TEST(test_degenerate_table);
     RUN_TEST(test_nan_inputs_are_ignored);
     RUN_TEST(test_robust_nan_samples_and_bad_args);

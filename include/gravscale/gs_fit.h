@@ -52,7 +52,7 @@ bool gs_fit_method_from_name(const char *s, size_t len, gs_fit_method *out);
  * on return bit i is set when sample first+i kept a positive final weight
  * (clear = rejected as outlier or unusable). min_scale_px: floor for the
  * residual scale (keeps perfect data from rejecting everything). No other
- * caller memory; hosts unpack up to 256 window samples on the stack (20 KB), a
+ * caller memory; hosts unpack up to 256 window samples on the stack (22 KB), a
  * size-optimised build (the firmware) reads them from the ring (gs_fit.c).
  * Returns GS_EINVAL when a sample is missing from the ring or < 3 remain
  * (with 3 the SE is NaN, as in gs_fit_solve). */

@@ -36,12 +36,21 @@
 /* two doubles, for the hot loops over a cached window (element-wise IEEE, as scalars) */
 typedef double gs_v2d __attribute__((vector_size(16)));
 typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lanes: -1 true, 0 false */
-/* lanes i and j of the four in (a, b): GCC's and clang's spellings of the same shuffle */
-#ifdef __clang__
-#define GS_V2_PICK(a, b, i, j) __builtin_shufflevector(a, b, i, j)
-#else
-#define GS_V2_PICK(a, b, i, j) __builtin_shuffle(a, b, (gs_v2l){i, j})
 #endif
+
+/* x86-64 hosts whose CPU has AVX2 take the loops over a fully usable cached window
+ * four samples to a register: the same IEEE operations lane by lane, no fused
+ * multiply-add (not enabled), sums still added sample after sample */
+#if GS_FIT_FAST && defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define GS_FIT_AVX2 1
+#define GS_AVX2 __attribute__((target("avx2,popcnt")))
+static bool fit_avx2(void)
+{
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
+}
+#else
+#define GS_FIT_AVX2 0
 #endif
 
 /* Tukey biweight tuning constant (95 % Gaussian efficiency in 1D). */
@@ -303,7 +312,7 @@ typedef struct {
 } gs_fsamp;
 
 /* Window samples unpacked on the stack by a fast build (2.3 KB with their residuals
- * and keys where gs_real is float, 20 KB in double) */
+ * and keys where gs_real is float, 22 KB in double) */
 #define GS_FIT_CACHE (GS_REAL_IS_FLOAT ? 64u : 256u)
 /* Fast builds: LMS triples already drawn, one bit each, for windows with at most this many */
 #define GS_FIT_SEEN_BITS 4096u
@@ -317,10 +326,10 @@ typedef struct {
     gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
-    gs_real *exy;             /* fast double builds: ... and their x, y residuals, side by side */
+    gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
     uint32_t *key;            /* the median's selection scratch */
     float *med_key;           /* fast builds: the last median's squared residual, as a float */
-    gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y (3 rows of m) */
+    gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y, w (4 rows of m) */
     struct gs_wlast *last;    /* fast builds: the last reweighting's sums, solved in full only at the end */
 } gs_win;
 
@@ -413,6 +422,20 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
     if (dab == GS_R(0.0) || dac == GS_R(0.0) || dbc == GS_R(0.0)) {
         return false;
     }
+#if GS_FIT_FAST && defined(__GNUC__)
+    if (!GS_REAL_IS_FLOAT) {
+        /* fast double builds: both axes side by side, the same operations */
+        gs_v2d va = {a->xy_px[0], a->xy_px[1]}, vb = {b->xy_px[0], b->xy_px[1]}, vc = {c->xy_px[0], c->xy_px[1]};
+        gs_v2d sab = (vb - va) / (gs_v2d){dab, dab}, sac = (vc - va) / (gs_v2d){dac, dac};
+        gs_v2d c2 = (sac - sab) / (gs_v2d){dbc, dbc};
+        gs_v2d c1 = sab - c2 * (gs_v2d){ta + tb, ta + tb};
+        gs_v2d c0 = va - (gs_v2d){ta, ta} * (c1 + c2 * (gs_v2d){ta, ta});
+        gs_v2d fin = (c0 - c0) + (c1 - c1) + (c2 - c2); /* x - x is 0 exactly when x is finite */
+        p->c[0] = c0[0], p->c[1] = c1[0], p->c[2] = c2[0];
+        p->c[3] = c0[1], p->c[4] = c1[1], p->c[5] = c2[1];
+        return fin[0] == 0.0 && fin[1] == 0.0;
+    }
+#endif
     for (axis = 0; axis < 2; axis++) {
         gs_real va = a->xy_px[axis];
         gs_real vb = b->xy_px[axis];
@@ -470,6 +493,32 @@ static float select_key(uint32_t *key, uint32_t n, uint32_t k)
     return v;
 }
 
+#if GS_FIT_AVX2
+/* select_near's pass four keys at a time: the keys x with lo_b <= x < lo_b + span
+ * (unsigned) to buf in order, the ones below lo_b counted. Returns the keys it did. */
+GS_AVX2 static uint32_t near_keys_avx2(const uint32_t *key, uint32_t *buf, uint32_t n, uint32_t lo_b, uint32_t span,
+                                       uint32_t *below, uint32_t *m)
+{
+    /* the lanes of a 4-bit set, in order, a byte each */
+    static const uint32_t pick[16] = {0u,      0x00u,     0x01u,     0x0100u,   0x02u,     0x0200u,
+                                      0x0201u, 0x020100u, 0x03u,     0x0300u,   0x0301u,   0x030100u,
+                                      0x0302u, 0x030200u, 0x030201u, 0x03020100u};
+    __m128i vlo = _mm_set1_epi32((int)lo_b), vspan = _mm_set1_epi32((int)span);
+    uint32_t i;
+    for (i = 0; i + 4u <= n; i += 4u) {
+        __m128i x = _mm_loadu_si128((const __m128i *)(const void *)&key[i]), d = _mm_sub_epi32(x, vlo);
+        unsigned ge = (unsigned)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_max_epu32(x, vlo), x)));
+        unsigned out = (unsigned)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_max_epu32(d, vspan), d)));
+        unsigned in = ~out & 15u;
+        __m128i lanes = _mm_cvtepu8_epi32(_mm_cvtsi32_si128((int)pick[in]));
+        *below += 4u - (uint32_t)__builtin_popcount(ge);
+        _mm_storeu_ps((float *)(void *)&buf[*m], _mm_permutevar_ps(_mm_castsi128_ps(x), lanes));
+        *m += (uint32_t)__builtin_popcount(in);
+    }
+    return i;
+}
+#endif
+
 #if GS_FIT_FAST
 /* select_key with a guess: the keys within a quarter of hint_key's value either way go
  * to buf, the ones below are counted; when the k-th lies among them it is selected from
@@ -484,7 +533,13 @@ static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, f
     }
     memcpy(&lo_b, &lo, sizeof lo_b);
     memcpy(&hi_b, &hi, sizeof hi_b);
-    for (i = 0; i < n; i++) {
+    i = 0;
+#if GS_FIT_AVX2
+    if (fit_avx2()) {
+        i = near_keys_avx2(key, buf, n, lo_b, hi_b - lo_b, &below, &m);
+    }
+#endif
+    for (; i < n; i++) {
         uint32_t x = key[i];
         below += (uint32_t)(x < lo_b);
         buf[m] = x;
@@ -494,6 +549,206 @@ static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, f
         return select_key(buf, m, k - below);
     }
     return select_key(key, n, k);
+}
+#endif
+
+#if GS_FIT_AVX2
+/* Lanes [0, n) of four set (n <= 4), as doubles' and as floats' masks. */
+static const int64_t lanes64[8] = {-1, -1, -1, -1, 0, 0, 0, 0};
+static const int32_t lanes32[8] = {-1, -1, -1, -1, 0, 0, 0, 0};
+#define GS_LANES64(n) _mm256_loadu_si256((const __m256i *)(const void *)&lanes64[4u - (n)])
+/* the window's rows as doubles: the kernels below run only where gs_real is double (their
+ * callers test GS_REAL_IS_FLOAT), the float build compiles them as dead code */
+#define GS_D(rows) ((double *)(void *)(rows))
+#define GS_LANES32(n) _mm_loadu_si128((const __m128i *)(const void *)&lanes32[4u - (n)])
+
+/* The parabola's residuals of four samples of a fully usable cached window (lanes
+ * past the window's end read as 0), rows t, x, y; the x and y residual to *ex, *ey. */
+GS_AVX2 static inline __m256d resid4_avx2(const gs_win *wn, const __m256d c[6], uint32_t i, __m256i lanes,
+                                          __m256d *ex, __m256d *ey)
+{
+    const double *t = GS_D(wn->soa), *x = t + GS_FIT_CACHE, *y = t + 2u * GS_FIT_CACHE;
+    __m256d tau = _mm256_maskload_pd(&t[i], lanes);
+    *ex = _mm256_sub_pd(_mm256_maskload_pd(&x[i], lanes),
+                        _mm256_add_pd(c[0], _mm256_mul_pd(tau, _mm256_add_pd(c[1], _mm256_mul_pd(tau, c[2])))));
+    *ey = _mm256_sub_pd(_mm256_maskload_pd(&y[i], lanes),
+                        _mm256_add_pd(c[3], _mm256_mul_pd(tau, _mm256_add_pd(c[4], _mm256_mul_pd(tau, c[5])))));
+    return _mm256_add_pd(_mm256_mul_pd(*ex, *ex), _mm256_mul_pd(*ey, *ey));
+}
+
+GS_AVX2 static inline void par_lanes_avx2(const gs_par *p, __m256d c[6])
+{
+    c[0] = _mm256_set1_pd(p->c[0]);
+    c[1] = _mm256_set1_pd(p->c[1]);
+    c[2] = _mm256_set1_pd(p->c[2]);
+    c[3] = _mm256_set1_pd(p->c[3]);
+    c[4] = _mm256_set1_pd(p->c[4]);
+    c[5] = _mm256_set1_pd(p->c[5]);
+}
+
+/* median_resid's pass over a fully usable cached window, four samples at a time:
+ * each sample's x, y residual and squared norm to the rows, its float to the keys. */
+GS_AVX2 static void resid_rows_avx2(const gs_win *wn, const gs_par *p)
+{
+    __m256d c[6], ex, ey, r2;
+    uint32_t i;
+    par_lanes_avx2(p, c);
+    for (i = 0; i + 4u <= wn->count; i += 4u) {
+        r2 = resid4_avx2(wn, c, i, GS_LANES64(4u), &ex, &ey);
+        _mm256_storeu_pd(&GS_D(wn->r2)[i], r2);
+        _mm256_storeu_pd(&GS_D(wn->exy)[i], ex);
+        _mm256_storeu_pd(&GS_D(wn->exy)[GS_FIT_CACHE + i], ey);
+        _mm_storeu_ps((float *)(void *)&wn->key[i], _mm256_cvtpd_ps(r2));
+    }
+    if (i < wn->count) {
+        __m256i lanes = GS_LANES64(wn->count - i);
+        r2 = resid4_avx2(wn, c, i, lanes, &ex, &ey);
+        _mm256_maskstore_pd(&GS_D(wn->r2)[i], lanes, r2);
+        _mm256_maskstore_pd(&GS_D(wn->exy)[i], lanes, ex);
+        _mm256_maskstore_pd(&GS_D(wn->exy)[GS_FIT_CACHE + i], lanes, ey);
+        _mm_maskstore_ps((float *)(void *)&wn->key[i], GS_LANES32(wn->count - i), _mm256_cvtpd_ps(r2));
+    }
+}
+
+/* median_below_cached's count, eight samples at a time: the same verdict, which only counts. */
+GS_AVX2 static bool median_below_avx2(const gs_win *wn, const gs_par *p, double T, uint32_t need, uint32_t room)
+{
+    __m256d c[6], vT = _mm256_set1_pd(T), ex, ey;
+    __m256i all = GS_LANES64(4u);
+    uint32_t m = wn->m, less = 0, j;
+    unsigned bits;
+    par_lanes_avx2(p, c);
+    for (j = 0; j + 8u <= m; j += 8u) {
+        bits = (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(resid4_avx2(wn, c, j, all, &ex, &ey), vT, _CMP_LT_OQ)) |
+               (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(resid4_avx2(wn, c, j + 4u, all, &ex, &ey), vT, _CMP_LT_OQ))
+                   << 4;
+        less += (uint32_t)__builtin_popcount(bits);
+        if (less >= need) {
+            return true;
+        }
+        if (j + 8u - less > room) {
+            return false;
+        }
+    }
+    for (; j < m; j += 4u) {
+        uint32_t left = m - j < 4u ? m - j : 4u;
+        bits = (unsigned)_mm256_movemask_pd(
+            _mm256_cmp_pd(resid4_avx2(wn, c, j, GS_LANES64(left), &ex, &ey), vT, _CMP_LT_OQ));
+        less += (uint32_t)__builtin_popcount(bits & ((1u << left) - 1u));
+    }
+    return less >= need;
+}
+
+/* Adds the four samples' (a, b, c, d) to acc's four sums, sample after sample. */
+GS_AVX2 static inline __m256d add4_avx2(__m256d acc, __m256d a, __m256d b, __m256d c, __m256d d)
+{
+    __m256d ab02 = _mm256_unpacklo_pd(a, b), ab13 = _mm256_unpackhi_pd(a, b);
+    __m256d cd02 = _mm256_unpacklo_pd(c, d), cd13 = _mm256_unpackhi_pd(c, d);
+    acc = _mm256_add_pd(acc, _mm256_permute2f128_pd(ab02, cd02, 0x20));
+    acc = _mm256_add_pd(acc, _mm256_permute2f128_pd(ab13, cd13, 0x20));
+    acc = _mm256_add_pd(acc, _mm256_permute2f128_pd(ab02, cd02, 0x31));
+    return _mm256_add_pd(acc, _mm256_permute2f128_pd(ab13, cd13, 0x31));
+}
+
+/* sum + the four lanes of v, one after the other. */
+GS_AVX2 static inline double add_lanes_avx2(double sum, __m256d v)
+{
+    __m128d lo = _mm256_castpd256_pd128(v), hi = _mm256_extractf128_pd(v, 1);
+    sum += _mm_cvtsd_f64(lo);
+    sum += _mm_cvtsd_f64(_mm_unpackhi_pd(lo, lo));
+    sum += _mm_cvtsd_f64(hi);
+    return sum + _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi));
+}
+
+/* wsums_cached's IRLS step over a fully usable cached window, four samples at a time:
+ * the Tukey weights from the median's residuals, the same products, each sum taken in
+ * sample order. A rejected sample's lanes are zeroed and add +0 or -0, which leaves a
+ * sum as it is (a sum that starts at +0 is never -0). s: g0..g4, bx0..2, by0..2, eex,
+ * eey; the kept bits to keep (bits past count keep their values). The residuals are
+ * the median's (wn->r2, wn->exy). Returns the samples kept. */
+GS_AVX2 static uint32_t wsums_tukey_avx2(const gs_win *wn, double cut, uint32_t *keep, double s[13])
+{
+    const double *r2 = GS_D(wn->r2);
+    const double *t = GS_D(wn->soa), *wp = GS_D(wn->soa) + 3u * GS_FIT_CACHE, *ex_row = GS_D(wn->exy), *ey_row = GS_D(wn->exy) + GS_FIT_CACHE;
+    __m256d vcut = _mm256_set1_pd(cut), one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
+    __m256d g = zero, b01 = zero, b2e = zero; /* (g0 g1 g2 g3), (bx0 by0 bx1 by1), (bx2 by2 eex eey) */
+    double g4 = 0.0, v[12];
+    uint32_t n = 0, word = 0, i;
+    for (i = 0; i < wn->count; i += 4u) {
+        uint32_t left = wn->count - i < 4u ? wn->count - i : 4u;
+        __m256i lanes = GS_LANES64(left);
+        __m256d r = _mm256_sqrt_pd(_mm256_maskload_pd(&r2[i], lanes));
+        __m256d in = _mm256_and_pd(_mm256_cmp_pd(r, vcut, _CMP_LT_OQ), _mm256_castsi256_pd(lanes));
+        __m256d u = _mm256_div_pd(r, vcut), w, ex, ey, tau, wt1, wt2, wt3, wx, wy;
+        unsigned bits;
+        u = _mm256_sub_pd(one, _mm256_mul_pd(u, u));
+        w = _mm256_cvtps_pd(_mm256_cvtpd_ps(_mm256_mul_pd(_mm256_maskload_pd(&wp[i], lanes), _mm256_mul_pd(u, u))));
+        in = _mm256_and_pd(in, _mm256_cmp_pd(w, zero, _CMP_GT_OQ));
+        bits = (unsigned)_mm256_movemask_pd(in);
+        word |= bits << (i & 31u);
+        if (((i + 4u) & 31u) == 0u || i + left == wn->count) {
+            uint32_t end = (i & 31u) + left, mask = end == 32u ? ~0u : (1u << end) - 1u;
+            keep[i >> 5] = (keep[i >> 5] & ~mask) | word;
+            word = 0;
+        }
+        if (bits == 0u) {
+            continue; /* nothing to add */
+        }
+        n += (uint32_t)__builtin_popcount(bits);
+        w = _mm256_and_pd(w, in);
+        ex = _mm256_and_pd(_mm256_maskload_pd(&ex_row[i], lanes), in);
+        ey = _mm256_and_pd(_mm256_maskload_pd(&ey_row[i], lanes), in);
+        tau = _mm256_maskload_pd(&t[i], lanes);
+        wt1 = _mm256_mul_pd(w, tau);
+        wt2 = _mm256_mul_pd(wt1, tau);
+        wt3 = _mm256_mul_pd(wt2, tau);
+        wx = _mm256_mul_pd(w, ex);
+        wy = _mm256_mul_pd(w, ey);
+        g = add4_avx2(g, w, wt1, wt2, wt3);
+        b01 = add4_avx2(b01, wx, wy, _mm256_mul_pd(wt1, ex), _mm256_mul_pd(wt1, ey));
+        b2e = add4_avx2(b2e, _mm256_mul_pd(wt2, ex), _mm256_mul_pd(wt2, ey), _mm256_mul_pd(wx, ex),
+                        _mm256_mul_pd(wy, ey));
+        g4 = add_lanes_avx2(g4, _mm256_mul_pd(wt3, tau));
+    }
+    _mm256_storeu_pd(&v[0], g);
+    _mm256_storeu_pd(&v[4], b01);
+    _mm256_storeu_pd(&v[8], b2e);
+    s[0] = v[0], s[1] = v[1], s[2] = v[2], s[3] = v[3], s[4] = g4;
+    s[5] = v[4], s[6] = v[6], s[7] = v[8];  /* bx0 bx1 bx2 */
+    s[8] = v[5], s[9] = v[7], s[10] = v[9]; /* by0 by1 by2 */
+    s[11] = v[10], s[12] = v[11];           /* eex eey */
+    return n;
+}
+
+/* tukey_loss over a fully usable cached window: the terms four at a time, summed in
+ * sample order. */
+GS_AVX2 static double tukey_loss_avx2(const gs_win *wn, const gs_par *p, double cut)
+{
+    const double *wp = GS_D(wn->soa) + 3u * GS_FIT_CACHE;
+    __m256d c[6], vcut = _mm256_set1_pd(cut), one = _mm256_set1_pd(1.0), ex, ey;
+    double loss = 0.0;
+    uint32_t i;
+    par_lanes_avx2(p, c);
+    for (i = 0; i < wn->count; i += 4u) {
+        uint32_t left = wn->count - i < 4u ? wn->count - i : 4u;
+        __m256i lanes = GS_LANES64(left);
+        __m256d u = _mm256_div_pd(_mm256_sqrt_pd(resid4_avx2(wn, c, i, lanes, &ex, &ey)), vcut);
+        __m256d v = _mm256_sub_pd(one, _mm256_mul_pd(u, u));
+        __m256d rho = _mm256_blendv_pd(one, _mm256_sub_pd(one, _mm256_mul_pd(_mm256_mul_pd(v, v), v)),
+                                       _mm256_cmp_pd(u, one, _CMP_LT_OQ));
+        __m256d term = _mm256_mul_pd(_mm256_maskload_pd(&wp[i], lanes), rho);
+        if (left == 4u) {
+            loss = add_lanes_avx2(loss, term);
+        } else {
+            double tv[4];
+            uint32_t k;
+            _mm256_storeu_pd(tv, term);
+            for (k = 0; k < left; k++) {
+                loss += tv[k];
+            }
+        }
+    }
+    return loss;
 }
 #endif
 
@@ -519,10 +774,17 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
         uint32_t n = 0;
 #if defined(__GNUC__)
         if (!GS_REAL_IS_FLOAT && wn->m == wn->count) {
-            /* every sample usable: the rows of median_below_cached, two at a time */
+            /* every sample usable: the rows of median_below_cached, four or two at a time */
             const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
             gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5};
-            for (i = 0; i + 1u < wn->count; i += 2u) {
+            i = 0;
+#if GS_FIT_AVX2
+            if (fit_avx2()) {
+                resid_rows_avx2(wn, p);
+                i = wn->count;
+            }
+#endif
+            for (; i + 1u < wn->count; i += 2u) {
                 gs_v2d tau, vx, vy, ex, ey, r2;
                 float f0, f1;
                 memcpy(&tau, &t[i], sizeof tau);
@@ -532,11 +794,8 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 ey = vy - (v3 + tau * (v4 + tau * v5));
                 r2 = ex * ex + ey * ey;
                 memcpy(&wn->r2[i], &r2, sizeof r2);
-                {
-                    gs_v2d e0 = GS_V2_PICK(ex, ey, 0, 2), e1 = GS_V2_PICK(ex, ey, 1, 3);
-                    memcpy(&wn->exy[2u * i], &e0, sizeof e0);
-                    memcpy(&wn->exy[2u * i + 2u], &e1, sizeof e1);
-                }
+                memcpy(&wn->exy[i], &ex, sizeof ex);
+                memcpy(&wn->exy[GS_FIT_CACHE + i], &ey, sizeof ey);
                 f0 = (float)r2[0];
                 f1 = (float)r2[1];
                 memcpy(&wn->key[i], &f0, sizeof f0);
@@ -553,8 +812,8 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 gs_real r2 = ex * ex + ey * ey;
                 float f = (float)r2;
                 wn->r2[i] = r2;
-                wn->exy[2u * i] = ex;
-                wn->exy[2u * i + 1u] = ey;
+                wn->exy[i] = ex;
+                wn->exy[GS_FIT_CACHE + i] = ey;
                 memcpy(&wn->key[n++], &f, sizeof f);
             }
         }
@@ -666,6 +925,11 @@ static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key
     gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
     double T = below_key(med_key);
     uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
+#if GS_FIT_AVX2
+    if (fit_avx2()) {
+        return median_below_avx2(wn, p, T, need, room);
+    }
+#endif
 #if defined(__GNUC__)
     gs_v2d v0 = {c0, c0}, v1 = {c1, c1}, v2 = {c2, c2}, v3 = {c3, c3}, v4 = {c4, c4}, v5 = {c5, c5}, vT = {T, T};
     for (; j + 3u < m; j += 4u) {
@@ -824,6 +1088,19 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
 #if defined(__GNUC__)
     gs_v2d p0 = {base->c[0], base->c[3]}, p1 = {base->c[1], base->c[4]}, p2 = {base->c[2], base->c[5]};
     gs_v2d ee = {g0, g0}, v0 = ee, v1 = ee, v2 = ee;
+    i = 0;
+#if GS_FIT_AVX2
+    if (mode == W_TUKEY && r2 && wn->m == wn->count && fit_avx2()) {
+        double s[13];
+        n = wsums_tukey_avx2(wn, cut, keep, s); /* r2 is the median's: wn->r2 */
+        i = wn->count;
+        g0 = s[0], g1 = s[1], g2 = s[2], g3 = s[3], g4 = s[4];
+        v0 = (gs_v2d){s[5], s[8]};
+        v1 = (gs_v2d){s[6], s[9]};
+        v2 = (gs_v2d){s[7], s[10]};
+        ee = (gs_v2d){s[11], s[12]};
+    } else
+#endif
     if (mode == W_TUKEY && r2) {
         /* an IRLS step: the residuals from model (= base) the median left, 32 samples a word */
         uint32_t i0;
@@ -851,7 +1128,7 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
                 wr = (gs_real)w;
                 word |= 1u << (i - i0);
                 wv = (gs_v2d){wr, wr};
-                memcpy(&e, &wn->exy[2u * i], sizeof e);
+                e = (gs_v2d){wn->exy[i], wn->exy[GS_FIT_CACHE + i]};
                 ee += wv * e * e;
                 g0 += wr;
                 v0 += wv * e;
@@ -873,8 +1150,6 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
             keep[i0 >> 5] = (keep[i0 >> 5] & ~mask) | word;
         }
         i = wn->count; /* the general loop below has nothing left */
-    } else {
-        i = 0;
     }
 #else
     i = 0;
@@ -1198,6 +1473,11 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
 {
     gs_real cut = GS_FIT_TUKEY_C * floor_px, loss = GS_R(0.0);
     uint32_t i;
+#if GS_FIT_AVX2
+    if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE && wn->m == wn->count && fit_avx2()) {
+        return tukey_loss_avx2(wn, p, cut);
+    }
+#endif
 #if GS_FIT_FAST
     if (wn->count <= GS_FIT_CACHE) {
         /* the same sum over the cache, the curve in registers */
@@ -1375,6 +1655,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
                 wn->soa[n] = wn->cache[i].tau;
                 wn->soa[GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[0];
                 wn->soa[2u * GS_FIT_CACHE + n] = (gs_real)wn->cache[i].xy_px[1];
+                wn->soa[3u * GS_FIT_CACHE + n] = (gs_real)wn->cache[i].w;
                 n++;
             }
         }
@@ -1406,7 +1687,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     uint32_t key[GS_FIT_FAST ? 2u * GS_FIT_CACHE : 1u]; /* the keys, and select_near's few */
 #if GS_FIT_FAST
     float med_key = 0.0f;
-    gs_real soa[GS_REAL_IS_FLOAT ? 1u : 3u * GS_FIT_CACHE];
+    gs_real soa[GS_REAL_IS_FLOAT ? 1u : 4u * GS_FIT_CACHE];
     gs_real exy[2u * GS_FIT_CACHE];
     gs_wlast last;
 #endif
