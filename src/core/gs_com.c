@@ -336,7 +336,7 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
  * the two pairs are roughly parallel, so this also holds in lateral views.
  * l and ol are the left keypoints of the pair and of the other pair (right = left + 1). */
-static void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
+static NOINLINE void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
 {
     uint32_t seen = f->obs & BIT2(l, l + 1);
     if (seen == 0 || seen == BIT2(l, l + 1) || !all_in(f->obs, BIT2(ol, ol + 1))) {
@@ -364,7 +364,7 @@ static bool centre_of(const frame *f, uint32_t set, int a, int b, vec2 *out)
 
 /* Centre of the left/right pair from l (the right one follows): a lone point
  * stands for the pair in a lateral view. */
-static bool pair_centre(const frame *f, uint32_t set, int l, vec2 *out)
+static NOINLINE bool pair_centre(const frame *f, uint32_t set, int l, vec2 *out)
 {
     return centre_of(f, set, l, l + 1, out);
 }

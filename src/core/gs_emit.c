@@ -9,6 +9,14 @@
 
 #include "gs_dbits.h"
 
+/* one copy of a helper called from several places: smaller code where the build optimises
+ * for size (the firmware); elsewhere the compiler inlines what pays */
+#ifdef __OPTIMIZE_SIZE__
+#define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
+
 /* NMEA 0183 caps a sentence at 82 characters including "$" and CR LF. */
 #define NMEA_MAX 82u
 
@@ -198,7 +206,7 @@ static void n_text(gs_w *w, const char *s, size_t max_len)
 static const char k_hex_upper[] = "0123456789ABCDEF";
 
 /* after its comma */
-static void w_nmea_value(gs_w *w, const void *base, const field *f)
+static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
 {
     if (w_common(w, base, f)) return;
     const void *p = field_at(base, f);

@@ -4,6 +4,14 @@
 #include <math.h>
 #include <string.h>
 
+/* one copy of a helper called from several places: smaller code where the build optimises
+ * for size (the firmware); elsewhere the compiler inlines what pays */
+#ifdef __OPTIMIZE_SIZE__
+#define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
+
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
 #define FAST_REL    0.5f   /* a falling foot meets the floor faster than this x size per second */
@@ -25,7 +33,7 @@
 static bool fin(float v) { return v == v && v - v == 0.0f; }
 
 /* the tracking state of a point, not its logged events */
-static void reset_track(gs_foot *f)
+static NOINLINE void reset_track(gs_foot *f)
 {
     for (int k = 0; k < GS_FEET_HIST; k++) f->u_px[k] = NAN;
     f->rest_px = f->floor_px = NAN;
@@ -59,10 +67,10 @@ static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float fro
 }
 
 /* slot of the frame `back` frames before the newest (0: the newest) */
-static unsigned slot(const gs_feet *ft, uint32_t back) { return (ft->n - 1u - back) % GS_FEET_HIST; }
+static NOINLINE unsigned slot(const gs_feet *ft, uint32_t back) { return (ft->n - 1u - back) % GS_FEET_HIST; }
 
 /* frames held in the history (two slots are the pending frame and the one after it) */
-static uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - 2u ? ft->n : GS_FEET_HIST - 2u; }
+static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - 2u ? ft->n : GS_FEET_HIST - 2u; }
 
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(ft, 0)] - ft->t_us[slot(ft, back)]; }
@@ -96,7 +104,7 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
  * of both: from the last frame surely above them the point falls on to L from its speed
  * between that frame and the one before, accelerating as a body falls, and reaches L no
  * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
-static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
+static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
 {
     uint32_t bk[GS_FEET_HIST];  /* finite frames, newest first (a missing or outlier frame is bridged) */
     unsigned n = 0;

@@ -253,7 +253,7 @@ static gs_real med3(gs_real a, gs_real b, gs_real c)
 }
 
 static void restart_levels(gs_flight *f, uint32_t i);
-static float last_stand_size(const gs_flight *f);
+static NOINLINE float last_stand_size(const gs_flight *f);
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
@@ -542,7 +542,7 @@ typedef struct {
 } fit_memo;
 
 /* gs_fit_robust of ring samples [first, first+count) into f->keep, once per memo */
-static gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, uint32_t count, gs_fit_method method,
+static NOINLINE gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, uint32_t count, gs_fit_method method,
                             float min_scale, gs_fit_result *r)
 {
 #ifdef __OPTIMIZE_SIZE__

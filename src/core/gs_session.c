@@ -4,6 +4,14 @@
 #include <math.h>
 #include <string.h>
 
+/* one copy of a helper called from several places: smaller code where the build optimises
+ * for size (the firmware); elsewhere the compiler inlines what pays */
+#ifdef __OPTIMIZE_SIZE__
+#define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
+
 #define GAP_MAX_US 500000  /* an absence this long (or the absence limit, when shorter) is a gap */
 #define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
 
@@ -60,7 +68,7 @@ static bool elapsed(int64_t t_us, int64_t t0_us, int64_t span_us)
 }
 
 /* finite and > 0 */
-static bool positive(gs_real x) { return x > GS_R(0.0) && x < (gs_real)INFINITY; }
+static NOINLINE bool positive(gs_real x) { return x > GS_R(0.0) && x < (gs_real)INFINITY; }
 
 uint32_t gs_session_frame(gs_session *s, int64_t t_us, bool present, gs_real stand_px, const char **end_reason)
 {
@@ -95,7 +103,7 @@ uint32_t gs_session_frame(gs_session *s, int64_t t_us, bool present, gs_real sta
 }
 
 /* a known value into a sum and its count, and into the best (largest) when given */
-static void tally(gs_real x, gs_real *sum, uint32_t *n, gs_real *best)
+static NOINLINE void tally(gs_real x, gs_real *sum, uint32_t *n, gs_real *best)
 {
     if (!isfinite(x)) return;
     *sum += x;
