@@ -281,12 +281,16 @@ static double fps_from_times(const gs_kpframe *f, size_t n)
     return (double)k / sum;
 }
 
-static void push_frame(replay_app *a, gs_pipeline *p, gs_layout layout, const gs_kpframe *f)
+/* com: the frame's COM from the reader's thread, NULL to compute it here. */
+static void push_frame(replay_app *a, gs_pipeline *p, gs_layout layout, const gs_kpframe *f,
+                       const kp_ahead_com *com)
 {
     gs_status st;
     if (layout == GS_LAYOUT_POINT)
         st = gs_pipeline_push_point(p, f->t_s, f->kp[0].x_px, f->kp[0].y_px, f->kp[0].c,
                                     f->size_px);
+    else if (com)
+        st = com->st != GS_OK ? com->st : gs_pipeline_push_com(p, f->t_s, f->kp, &com->out);
     else
         st = gs_pipeline_push_keypoints(p, f->t_s, f->kp);
     if (st != GS_OK && a->refused++ == 0)
@@ -381,21 +385,23 @@ int gs_cmd_replay(int argc, char **argv)
     progress pg = {isatty(STDERR_FILENO) != 0, false, now_s() + 0.25};
     uint64_t frames = 0;
     for (size_t i = 0; i < npre && !app.out.err; i++, frames++)
-        push_frame(&app, pl, layout, &pre[i]);
+        push_frame(&app, pl, layout, &pre[i], NULL);
     kp_ahead *ahead = NULL;
     if (ks == GS_KPR_FRAME) {
-        /* a file is read ahead in a second thread; a pipe or a terminal frame by frame, so
-         * that each frame's events leave as soon as its line arrives */
+        /* a file is read ahead in a second thread, which computes the COM too; a pipe or a
+         * terminal frame by frame, so that each frame's events leave as soon as its line
+         * arrives */
         uint64_t done_bytes, total_bytes;
         gs_kpread_progress(rd, &done_bytes, &total_bytes);
         if (total_bytes > 0)
-            ahead = kp_ahead_start(rd);
+            ahead = kp_ahead_start(rd, layout == GS_LAYOUT_POINT ? NULL : pl);
         while (!app.out.err) {
             const gs_kpframe *f = &pre[0];
-            ks = ahead ? kp_ahead_next(ahead, &f, &kerr) : gs_kpread_next(rd, &pre[0], &kerr);
+            const kp_ahead_com *com = NULL;
+            ks = ahead ? kp_ahead_next(ahead, &f, &com, &kerr) : gs_kpread_next(rd, &pre[0], &kerr);
             if (ks != GS_KPR_FRAME)
                 break;
-            push_frame(&app, pl, layout, f);
+            push_frame(&app, pl, layout, f, com);
             frames++;
             if (pg.on && (frames & 4095u) == 0)
                 progress_tick(&pg, rd, ahead, frames);
