@@ -45,14 +45,15 @@ static inline const char *gs_fastnum_scan(const char *p, double *out)
     p += digits;
     size_t frac = 0;
     if (d == (unsigned)('.' - '0')) {
-        p++;
-        while ((d = (unsigned)(unsigned char)p[frac] - '0') < 10u) {
+        if ((d = (unsigned)(unsigned char)p[1] - '0') >= 10u)
+            return NULL; /* "5.": no fraction digit */
+        m = m * 10u + d;
+        frac = 1;
+        while ((d = (unsigned)(unsigned char)p[1 + frac] - '0') < 10u) {
             m = m * 10u + d;
             frac++;
         }
-        if (frac == 0)
-            return NULL;
-        p += frac;
+        p += 1 + frac;
     }
     if (digits + frac > 15)
         return NULL;
