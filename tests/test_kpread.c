@@ -2,6 +2,7 @@
  * a table of bad CSV inputs (each with its expected line, field and message),
  * valid CSV of every layout (CRLF, missing keypoints, frame column, lines across
  * the 1 MiB read block), AlphaPose with two people and frames out of order,
+ * the fixed-order and the looked-up column passes agreeing on the sample,
  * OpenPose BODY_25 / COCO-18 mapped to COCO-17 keypoint by keypoint, and the
  * JSON tokenizer on good and bad documents. */
 #include <errno.h>
@@ -336,6 +337,89 @@ void test_csv_coco17_and_blazepose33(void)
         TEST_ASSERT_EQUAL_UINT64(40, n);
         check_layout_frames(fr, n, npts);
     }
+}
+
+/* The bundled sample in its own column order (t, x0, y0, c0, x1, ...: the reader's
+ * fixed-order pass) and with the keypoints' columns in other orders (the pass that
+ * looks up each column's role): the same frames, bit for bit. */
+#ifndef GS_SOURCE_DIR
+#define GS_SOURCE_DIR "."
+#endif
+#define SAMPLE_ROWS 400
+#define SAMPLE_COLS (1 + 3 * 17)
+
+static bool same_float_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+void test_csv_column_orders_agree(void)
+{
+    static char cell[SAMPLE_ROWS + 1][SAMPLE_COLS][24];
+    FILE *f = fopen(GS_SOURCE_DIR "/tests/data/sample_jumps.csv", "r");
+    TEST_ASSERT_NOT_NULL(f);
+    char line[2048];
+    int rows = 0;
+    while (rows <= SAMPLE_ROWS && fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\r\n")] = '\0';
+        int c = 0;
+        for (char *tok = line;; c++) { /* empty fields (a missing keypoint) included */
+            size_t l = strcspn(tok, ",");
+            TEST_ASSERT_TRUE(c < SAMPLE_COLS && l < sizeof cell[0][0]);
+            memcpy(cell[rows][c], tok, l);
+            cell[rows][c][l] = '\0';
+            if (tok[l] == '\0')
+                break;
+            tok += l + 1;
+        }
+        TEST_ASSERT_EQUAL_INT(SAMPLE_COLS, c + 1);
+        rows++;
+    }
+    fclose(f);
+    TEST_ASSERT_TRUE(rows > 300);
+    /* column c of each order: 0 is t; 3k+1..3k+3 are x_k, y_k, c_k in the file */
+    static int order[3][SAMPLE_COLS];
+    for (int c = 0; c < SAMPLE_COLS; c++) order[0][c] = c;                            /* as written */
+    for (int k = 0; k < 17; k++)
+        for (int j = 0; j < 3; j++) {
+            order[1][1 + 3 * k + j] = 1 + 3 * (16 - k) + j;                           /* keypoints reversed */
+            order[2][1 + 3 * k + j] = 1 + 3 * k + (j + 2) % 3;                        /* c_k, x_k, y_k */
+        }
+    order[1][0] = order[2][0] = 0;
+    static gs_kpframe fr[3][SAMPLE_ROWS];
+    size_t n[3];
+    for (int v = 0; v < 3; v++) {
+        static char text[SAMPLE_ROWS * 2048];
+        size_t len = 0;
+        for (int r = 0; r < rows; r++)
+            for (int c = 0; c < SAMPLE_COLS; c++)
+                len += (size_t)snprintf(text + len, sizeof text - len, "%s%c", cell[r][order[v][c]],
+                                        c + 1 < SAMPLE_COLS ? ',' : '\n');
+        char path[256];
+        write_file_n("order.csv", text, len, path);
+        gs_kpread_opts o;
+        gs_kpread_opts_default(&o);
+        gs_kpread_error err;
+        gs_layout lay;
+        TEST_ASSERT_EQUAL_INT_MESSAGE(GS_KPR_EOF, read_all(path, &o, fr[v], SAMPLE_ROWS, &n[v], &err, &lay), err.text);
+        TEST_ASSERT_EQUAL_INT(GS_LAYOUT_COCO17, lay);
+        TEST_ASSERT_EQUAL_UINT64((uint64_t)(rows - 1), (uint64_t)n[v]);
+    }
+    for (int v = 1; v < 3; v++)
+        for (size_t i = 0; i < n[0]; i++) {
+            const gs_kpframe *a = &fr[0][i], *b = &fr[v][i];
+            char msg[64];
+            snprintf(msg, sizeof msg, "order %d, frame %u", v, (unsigned)i);
+            TEST_ASSERT_EQUAL_HEX64_MESSAGE(0, memcmp(&a->t_s, &b->t_s, sizeof a->t_s), msg);
+            TEST_ASSERT_EQUAL_UINT64_MESSAGE(a->frame, b->frame, msg);
+            TEST_ASSERT_TRUE_MESSAGE(isnan(a->size_px) && isnan(b->size_px), msg);
+            for (int k = 0; k < 17; k++)
+                TEST_ASSERT_TRUE_MESSAGE(same_float_bits(a->kp[k].x_px, b->kp[k].x_px) &&
+                                             same_float_bits(a->kp[k].y_px, b->kp[k].y_px) &&
+                                             same_float_bits(a->kp[k].c, b->kp[k].c),
+                                         msg);
+        }
+    /* and the values are the file's: every confidence against strtod */
+    for (int r = 1; r < rows; r++)
+        for (int k = 0; k < 17; k++)
+            TEST_ASSERT_TRUE(same_float_bits((float)strtod(cell[r][3 + 3 * k], NULL), fr[0][r - 1].kp[k].c));
 }
 
 void test_csv_frame_column_with_fps(void)
@@ -818,6 +902,7 @@ int main(void)
     RUN_TEST(test_csv_missing_file);
     RUN_TEST(test_csv_point_with_size_crlf_and_missing);
     RUN_TEST(test_csv_coco17_and_blazepose33);
+    RUN_TEST(test_csv_column_orders_agree);
     RUN_TEST(test_csv_frame_column_with_fps);
     RUN_TEST(test_csv_across_read_blocks);
     RUN_TEST(test_csv_line_longer_than_block);

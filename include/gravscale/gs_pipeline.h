@@ -51,12 +51,21 @@ void gs_pipeline_set_trace(gs_pipeline *p, bool on);
  * times are dropped silently; GS_EINVAL for GS_T_NONE, GS_ERANGE beyond
  * GS_T_MAX_US. */
 gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp);
+/* gs_pipeline_push_keypoints_us in its two steps, gs_pipeline_com then
+ * gs_pipeline_push_com_us, so that a host can compute the COM in another
+ * thread: gs_pipeline_com reads only what gs_pipeline_init set (the layout,
+ * mass table, stature method and min_conf), so it may run on later frames
+ * while p takes earlier ones. The keypoints go with their COM (they give the
+ * feet). GS_EINVAL for NULL. */
+gs_status gs_pipeline_com(const gs_pipeline *p, const gs_kp *kp, gs_com_out *com);
+gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp, const gs_com_out *com);
 /* One frame of a tracked point (GS_LAYOUT_POINT) with its size (NaN unknown). */
 gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, float y_px,
                                     float c, float size_px);
 /* The same with t_s in seconds (hosts), rounded to the microsecond
  * (gs_time_us_of_s): GS_EINVAL when not finite. */
 gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp);
+gs_status gs_pipeline_push_com(gs_pipeline *p, double t_s, const gs_kp *kp, const gs_com_out *com);
 gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px,
                                  float c, float size_px);
 /* End of stream: finish open flights and emit GS_EV_SUMMARY. Further pushes: GS_ESTATE. */

@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,7 @@
 
 #include "gravscale/gravscale.h"
 #include "app_common.h"
+#include "ev_behind.h"
 #include "gs_kpread.h"
 #include "gs_out.h"
 #include "gs_profile.h"
@@ -63,6 +65,8 @@ typedef struct {
     uint32_t emit_fail;       /* events the emitter could not format */
     uint64_t refused;         /* frames the pipeline refused (not expected: times are checked) */
     gs_status first_refusal;
+    ev_behind *behind;        /* events written in a second thread, NULL: here */
+    atomic_bool out_failed;   /* out.err is set: the run stops (read while behind writes) */
 } replay_app;
 
 static bool is_trace_event(gs_event_type t)
@@ -88,6 +92,23 @@ static void on_event(void *ctx, const gs_event *ev)
         gs_out_line(&a->out, buf, n);
     else
         a->emit_fail++;
+    if (a->out.err)
+        atomic_store_explicit(&a->out_failed, true, memory_order_relaxed);
+}
+
+/* The pipeline's events: to the writer thread while there is one. */
+static void route_event(void *ctx, const gs_event *ev)
+{
+    replay_app *a = ctx;
+    if (a->behind)
+        ev_behind_put(a->behind, ev);
+    else
+        on_event(a, ev);
+}
+
+static bool output_failed(const replay_app *a)
+{
+    return atomic_load_explicit(&a->out_failed, memory_order_relaxed);
 }
 
 /* ---- options ------------------------------------------------------------ */
@@ -281,12 +302,16 @@ static double fps_from_times(const gs_kpframe *f, size_t n)
     return (double)k / sum;
 }
 
-static void push_frame(replay_app *a, gs_pipeline *p, gs_layout layout, const gs_kpframe *f)
+/* com: the frame's COM from the reader's thread, NULL to compute it here. */
+static void push_frame(replay_app *a, gs_pipeline *p, gs_layout layout, const gs_kpframe *f,
+                       const kp_ahead_com *com)
 {
     gs_status st;
     if (layout == GS_LAYOUT_POINT)
         st = gs_pipeline_push_point(p, f->t_s, f->kp[0].x_px, f->kp[0].y_px, f->kp[0].c,
                                     f->size_px);
+    else if (com)
+        st = com->st != GS_OK ? com->st : gs_pipeline_push_com(p, f->t_s, f->kp, &com->out);
     else
         st = gs_pipeline_push_keypoints(p, f->t_s, f->kp);
     if (st != GS_OK && a->refused++ == 0)
@@ -332,6 +357,7 @@ int gs_cmd_replay(int argc, char **argv)
 
     replay_app app;
     memset(&app, 0, sizeof app);
+    atomic_init(&app.out_failed, false);
     app.fmt = o.out_format_set ? o.out_format : cfg.format;
     gs_out_open_fd(&app.out, STDOUT_FILENO, 0);
     if (o.trace) {
@@ -350,7 +376,7 @@ int gs_cmd_replay(int argc, char **argv)
     gs_kpframe *pre = malloc(PREFETCH_FRAMES * sizeof *pre);
     gs_status st = GS_ENOMEM;
     if (store && pl && pre)
-        st = gs_pipeline_init(pl, &cfg, layout, store, store_bytes, on_event, &app);
+        st = gs_pipeline_init(pl, &cfg, layout, store, store_bytes, route_event, &app);
     if (st != GS_OK) {
         fprintf(stderr, "gravscale: cannot start the pipeline: %s\n", gs_status_str(st));
         rc = EXIT_USAGE;
@@ -380,28 +406,35 @@ int gs_cmd_replay(int argc, char **argv)
 
     progress pg = {isatty(STDERR_FILENO) != 0, false, now_s() + 0.25};
     uint64_t frames = 0;
-    for (size_t i = 0; i < npre && !app.out.err; i++, frames++)
-        push_frame(&app, pl, layout, &pre[i]);
+    for (size_t i = 0; i < npre && !output_failed(&app); i++, frames++)
+        push_frame(&app, pl, layout, &pre[i], NULL);
     kp_ahead *ahead = NULL;
     if (ks == GS_KPR_FRAME) {
-        /* a file is read ahead in a second thread; a pipe or a terminal frame by frame, so
-         * that each frame's events leave as soon as its line arrives */
+        /* a file is read ahead in a second thread, which computes the COM too, and its events
+         * are written in a third; a pipe or a terminal is read frame by frame and its events
+         * written here, so that each frame's events leave as soon as its line arrives */
         uint64_t done_bytes, total_bytes;
         gs_kpread_progress(rd, &done_bytes, &total_bytes);
-        if (total_bytes > 0)
-            ahead = kp_ahead_start(rd);
-        while (!app.out.err) {
+        if (total_bytes > 0) {
+            ahead = kp_ahead_start(rd, layout == GS_LAYOUT_POINT ? NULL : pl);
+            if (ahead)
+                app.behind = ev_behind_start(on_event, &app);
+        }
+        while (!output_failed(&app)) {
             const gs_kpframe *f = &pre[0];
-            ks = ahead ? kp_ahead_next(ahead, &f, &kerr) : gs_kpread_next(rd, &pre[0], &kerr);
+            const kp_ahead_com *com = NULL;
+            ks = ahead ? kp_ahead_next(ahead, &f, &com, &kerr) : gs_kpread_next(rd, &pre[0], &kerr);
             if (ks != GS_KPR_FRAME)
                 break;
-            push_frame(&app, pl, layout, f);
+            push_frame(&app, pl, layout, f, com);
             frames++;
             if (pg.on && (frames & 4095u) == 0)
                 progress_tick(&pg, rd, ahead, frames);
         }
     }
     kp_ahead_stop(ahead);
+    ev_behind_stop(app.behind);
+    app.behind = NULL;
     progress_clear(&pg);
     if (app.out.err) {
         rc = output_status(&app);

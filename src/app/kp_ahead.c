@@ -11,6 +11,7 @@
 
 typedef struct {
     gs_kpframe f[AHEAD_BATCH_FRAMES];
+    kp_ahead_com com[AHEAD_BATCH_FRAMES];
     uint32_t n;
     gs_kpr_status end;   /* GS_KPR_FRAME while more frames follow this batch */
     gs_kpread_error err; /* the reader's error when end < 0 */
@@ -24,6 +25,7 @@ struct kp_ahead {
     unsigned filled; /* slots written and not yet given back */
     bool stop;       /* the caller gave up: the reader ends after its batch */
     gs_kpread *r;
+    const gs_pipeline *com_of; /* NULL: no COM */
     ahead_slot *slot;
     /* the caller's side */
     unsigned cur;    /* slot being handed out */
@@ -51,6 +53,8 @@ static void *reader_main(void *arg)
                 s->end = ks;
                 break;
             }
+            if (q->com_of)
+                s->com[s->n].st = gs_pipeline_com(q->com_of, s->f[s->n].kp, &s->com[s->n].out);
             s->n++;
         }
         gs_kpread_progress(q->r, &s->done_bytes, &s->total_bytes);
@@ -63,13 +67,14 @@ static void *reader_main(void *arg)
     }
 }
 
-kp_ahead *kp_ahead_start(gs_kpread *r)
+kp_ahead *kp_ahead_start(gs_kpread *r, const gs_pipeline *com_of)
 {
     kp_ahead *q = calloc(1, sizeof *q);
     if (!q)
         return NULL;
     q->slot = malloc(AHEAD_SLOTS * sizeof *q->slot);
     q->r = r;
+    q->com_of = com_of;
     bool mu = false, c1 = false, c2 = false;
     if (q->slot && (mu = pthread_mutex_init(&q->mu, NULL) == 0) &&
         (c1 = pthread_cond_init(&q->filled_cv, NULL) == 0) &&
@@ -87,12 +92,14 @@ kp_ahead *kp_ahead_start(gs_kpread *r)
     return NULL;
 }
 
-gs_kpr_status kp_ahead_next(kp_ahead *q, const gs_kpframe **f, gs_kpread_error *err)
+gs_kpr_status kp_ahead_next(kp_ahead *q, const gs_kpframe **f, const kp_ahead_com **com,
+                            gs_kpread_error *err)
 {
     for (;;) {
         if (q->have_cur) {
             ahead_slot *s = &q->slot[q->cur];
             if (q->next < s->n) {
+                *com = q->com_of ? &s->com[q->next] : NULL;
                 *f = &s->f[q->next++];
                 return GS_KPR_FRAME;
             }

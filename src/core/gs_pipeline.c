@@ -172,21 +172,24 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
     return GS_OK;
 }
 
-gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp)
+gs_status gs_pipeline_com(const gs_pipeline *p, const gs_kp *kp, gs_com_out *com)
 {
-    if (!p || !kp) return GS_EINVAL;
-    gs_com_out c;
-    gs_status st = gs_com_compute(p->layout, p->cfg.mass_table, p->cfg.stature, p->cfg.min_conf, kp, &c);
-    if (st != GS_OK) return st;
+    if (!p || !kp || !com) return GS_EINVAL;
+    return gs_com_compute(p->layout, p->cfg.mass_table, p->cfg.stature, p->cfg.min_conf, kp, com);
+}
+
+gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp, const gs_com_out *com)
+{
+    if (!p || !kp || !com) return GS_EINVAL;
     gs_sample_full s;
     s.t_us = t_us;
-    s.x_px = c.x_px;
-    s.y_px = c.y_px;
-    s.w = (isfinite(c.x_px) && isfinite(c.y_px)) ? c.w : 0.0f;
-    s.size_px = c.stature_px;
-    s.up_x = c.up_x;
-    s.up_y = c.up_y;
-    s.upright = c.upright;
+    s.x_px = com->x_px;
+    s.y_px = com->y_px;
+    s.w = (isfinite(com->x_px) && isfinite(com->y_px)) ? com->w : 0.0f;
+    s.size_px = com->stature_px;
+    s.up_x = com->up_x;
+    s.up_y = com->up_y;
+    s.upright = com->upright;
     float feet[2 * GS_FEET_POINTS];  /* x then y of each point, NaN missing */
     for (int k = 0; k < GS_FEET_POINTS; k++) {
         const gs_kp *f = &kp[k_feet_kp[p->layout][k]];
@@ -195,6 +198,14 @@ gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_k
         feet[GS_FEET_POINTS + k] = seen ? f->y_px : NAN;
     }
     return push_sample(p, &s, feet);
+}
+
+gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp)
+{
+    gs_com_out c;
+    gs_status st = gs_pipeline_com(p, kp, &c);
+    if (st != GS_OK) return st;
+    return gs_pipeline_push_com_us(p, t_us, kp, &c);
 }
 
 gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, float y_px,
@@ -226,6 +237,11 @@ static int64_t edge_us(double t_s)
 gs_status gs_pipeline_push_keypoints(gs_pipeline *p, double t_s, const gs_kp *kp)
 {
     return gs_pipeline_push_keypoints_us(p, edge_us(t_s), kp);
+}
+
+gs_status gs_pipeline_push_com(gs_pipeline *p, double t_s, const gs_kp *kp, const gs_com_out *com)
+{
+    return gs_pipeline_push_com_us(p, edge_us(t_s), kp, com);
 }
 
 gs_status gs_pipeline_push_point(gs_pipeline *p, double t_s, float x_px, float y_px, float c, float size_px)

@@ -26,33 +26,38 @@ static const double gs_fastnum_pow10[16] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e
  * has no end pointer. */
 static inline const char *gs_fastnum_scan(const char *p, double *out)
 {
-    bool neg = *p == '-';
-    p += neg || *p == '+';
-    const char *d0 = p;
-    uint64_t m = 0;
-    unsigned d;
-    while ((d = (unsigned)(unsigned char)*p - '0') < 10u) {
-        m = m * 10u + d; /* wraps beyond 19 digits: declined below anyway */
+    bool neg = false;
+    if ((unsigned char)*p < '0') { /* '+' and '-' sort below the digits */
+        neg = *p == '-';
+        if (!neg && *p != '+')
+            return NULL;
         p++;
     }
-    size_t digits = (size_t)(p - d0);
-    size_t frac = 0;
-    if (digits == 0)
+    unsigned d = (unsigned)(unsigned char)*p - '0';
+    if (d >= 10u)
         return NULL;
-    if (*p == '.') {
-        const char *f0 = ++p;
-        while ((d = (unsigned)(unsigned char)*p - '0') < 10u) {
-            m = m * 10u + d;
-            p++;
-        }
-        frac = (size_t)(p - f0);
-        if (frac == 0)
-            return NULL;
-        digits += frac;
+    uint64_t m = d;
+    size_t digits = 1;
+    while ((d = (unsigned)(unsigned char)p[digits] - '0') < 10u) {
+        m = m * 10u + d; /* wraps beyond 19 digits: declined below anyway */
+        digits++;
     }
-    if (digits > 15)
+    p += digits;
+    size_t frac = 0;
+    if (d == (unsigned)('.' - '0')) {
+        if ((d = (unsigned)(unsigned char)p[1] - '0') >= 10u)
+            return NULL; /* "5.": no fraction digit */
+        m = m * 10u + d;
+        frac = 1;
+        while ((d = (unsigned)(unsigned char)p[1 + frac] - '0') < 10u) {
+            m = m * 10u + d;
+            frac++;
+        }
+        p += 1 + frac;
+    }
+    if (digits + frac > 15)
         return NULL;
-    double v = (double)m / gs_fastnum_pow10[frac];
+    double v = (double)(int64_t)m / gs_fastnum_pow10[frac]; /* m < 10^15: exact */
     *out = neg ? -v : v;
     return p;
 }

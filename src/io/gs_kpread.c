@@ -44,6 +44,7 @@ struct gs_kpread {
     const char *name[CSV_MAX_COLS];
     int col_of_c[GS_KP_MAX];     /* column of c_k, for messages */
     bool has_t, has_frame, has_size;
+    bool t_then_xyc;             /* the columns are t, then x_k, y_k, c_k for k = 0, 1, ... */
     double fps;
     double last_t;
     bool have_last;
@@ -376,6 +377,9 @@ static gs_kpr_status csv_header(gs_kpread *r, const gs_kpread_opts *opts, gs_kpr
         r->eof = true;
     }
     r->layout = layout;
+    r->t_then_xyc = r->role[0] == ROLE_T && ncols == 1 + 3 * nkp;
+    for (int c = 1; r->t_then_xyc && c < ncols; c++)
+        r->t_then_xyc = r->role[c] == ROLE_X + (c - 1) % 3 && r->kidx[c] == (c - 1) / 3;
     r->has_t = seen_t != 0;
     r->has_frame = seen_frame != 0;
     r->has_size = seen_size != 0;
@@ -400,6 +404,52 @@ static gs_kpr_status csv_header(gs_kpread *r, const gs_kpread_opts *opts, gs_kpr
 }
 
 static bool parse_number(const char *s, size_t n, double *out) { return gs_fastnum_parse(s, n, out); }
+
+/* A row read by a fast pass: its time t must go forward (else false: the
+ * general pass decides), and it is the frame's. */
+static bool fast_row_done(gs_kpread *r, gs_kpframe *f, double t, double frame)
+{
+    if (r->have_last && !(t > r->last_t))
+        return false;
+    r->last_t = t;
+    r->have_last = true;
+    f->t_s = t;
+    f->frame = r->has_frame ? (uint64_t)frame : r->row;
+    r->row++;
+    return true;
+}
+
+/* csv_row_fast for the columns t, x0, y0, c0, x1, ...: no column's role to look up. */
+static bool csv_row_fast_xyc(gs_kpread *r, const char *s, size_t n, gs_kpframe *f)
+{
+    const char *e = s + n;
+    double t;
+    const char *q = gs_fastnum_scan(s, &t);
+    if (!q || *q != ',')
+        return false;
+    bool bad_c = false;
+    gs_kp *kp = f->kp;
+    int last = r->ncols / 3 - 1;
+    for (int k = 0;; k++) {
+        double x, y, c;
+        if (!(q = gs_fastnum_scan(q + 1, &x)) || *q != ',' || !(q = gs_fastnum_scan(q + 1, &y)) ||
+            *q != ',' || !(q = gs_fastnum_scan(q + 1, &c)))
+            return false;
+        float cv = (float)c;
+        kp[k].x_px = (float)x;
+        kp[k].y_px = (float)y;
+        kp[k].c = cv;
+        bad_c |= !(cv >= 0.0f && cv <= 1.0f);
+        if (k == last)
+            break;
+        if (*q != ',')
+            return false;
+    }
+    if (q != e || bad_c)
+        return false;
+    f->size_px = NAN;
+    return fast_row_done(r, f, t, NAN);
+}
 
 /* The common row, every field a plain decimal (a frame number plain digits), as
  * many as the header's, confidences within 0..1 and the time going forward: one
@@ -441,20 +491,13 @@ static bool csv_row_fast(gs_kpread *r, const char *s, size_t n, gs_kpframe *f)
         return false;
     if (!r->has_t)
         t = frame / r->fps;
-    if (r->have_last && !(t > r->last_t))
-        return false;
-    r->last_t = t;
-    r->have_last = true;
-    f->t_s = t;
-    f->frame = r->has_frame ? (uint64_t)frame : r->row;
-    r->row++;
-    return true;
+    return fast_row_done(r, f, t, frame);
 }
 
 static gs_kpr_status csv_row(gs_kpread *r, const char *s, size_t n, bool had_nl, gs_kpframe *f,
                              gs_kpread_error *err)
 {
-    if (r->ncols <= CSV_MAX_COLS && csv_row_fast(r, s, n, f))
+    if (r->t_then_xyc ? csv_row_fast_xyc(r, s, n, f) : r->ncols <= CSV_MAX_COLS && csv_row_fast(r, s, n, f))
         return GS_KPR_FRAME;
     const char *fs[CSV_MAX_COLS];
     size_t fl[CSV_MAX_COLS];
