@@ -7,13 +7,7 @@
 
 #include "gravscale/gs_com.h"
 
-/* one copy of a helper called from several places: smaller code on the Cortex-M4 (where
- * the build optimises for size); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_inline.h"
 
 #define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
 

@@ -4,13 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-/* one copy of a helper called from several places: smaller code where the build optimises
- * for size (the firmware); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_inline.h"
 
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */

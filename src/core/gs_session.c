@@ -4,13 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-/* one copy of a helper called from several places: smaller code where the build optimises
- * for size (the firmware); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_inline.h"
 
 #define GAP_MAX_US 500000  /* an absence this long (or the absence limit, when shorter) is a gap */
 #define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
