@@ -61,8 +61,10 @@ static void sort_asc(gs_real *v, uint32_t n)
     }
 }
 
-static gs_real median_sorted(const gs_real *v, uint32_t n)
+/* v sorted in place, and its median */
+static gs_real sort_median(gs_real *v, uint32_t n)
 {
+    sort_asc(v, n);
     return (n & 1u) ? v[n / 2] : GS_R(0.5) * (v[n / 2 - 1] + v[n / 2]);
 }
 
@@ -135,8 +137,7 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
             n_se++;
         }
     }
-    sort_asc(v, n);
-    gs_real med = median_sorted(v, n);
+    gs_real med = sort_median(v, n);
     out->height_m = med;
     gs_real rms_se = n_se > 0 ? GS_SQRT(se2_sum / n_se) : (gs_real)NAN;
 
@@ -150,9 +151,8 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         for (uint32_t i = 0; i < n; i++) {
             dev[i] = GS_FABSR(v[i] - med);
         }
-        sort_asc(dev, n);
         gs_real corr = n < 10 ? k_mad_corr[n] : (gs_real)n / ((gs_real)n - GS_R(0.8));
-        gs_real spread = MAD_TO_SIGMA * median_sorted(dev, n) * corr;
+        gs_real spread = MAD_TO_SIGMA * sort_median(dev, n) * corr;
         /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
         gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
         gs_real sigma = spread > se_floor ? spread : se_floor;
