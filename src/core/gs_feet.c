@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_finite.h"
 #include "gs_inline.h"
 
 /* thresholds in units of the body's size (stature, px) */
@@ -24,7 +25,8 @@
 #define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
 #define LAND_G_REL  5.8f   /* gravity in statures per s^2 (9.81 m/s^2 over a 1.7 m body): a landing foot's fall */
 
-static bool fin(float v) { return v == v && v - v == 0.0f; }
+/* one copy: called for nearly every height read */
+static NOINLINE bool fin(float v) { return gs_finite_f(v); }
 
 /* the tracking state of a point, not its logged events */
 static NOINLINE void reset_track(gs_foot *f)
