@@ -8,6 +8,8 @@
 
 #include "gravscale/gs_agg.h"
 
+#include "gs_median.h"
+
 /* With one flight the between-flight scatter cannot be seen; a per-flight
  * relative scatter (pose, size and outlier flights the fit's SE misses) is
  * assumed instead: 3 % of the value, 5 cm at 1.75 m. */
@@ -61,8 +63,9 @@ static void sort_asc(gs_real *v, uint32_t n)
     }
 }
 
-static gs_real median_sorted(const gs_real *v, uint32_t n)
+gs_real gs_sort_median(gs_real *v, uint32_t n)
 {
+    sort_asc(v, n);
     return (n & 1u) ? v[n / 2] : GS_R(0.5) * (v[n / 2 - 1] + v[n / 2]);
 }
 
@@ -135,8 +138,7 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
             n_se++;
         }
     }
-    sort_asc(v, n);
-    gs_real med = median_sorted(v, n);
+    gs_real med = gs_sort_median(v, n);
     out->height_m = med;
     gs_real rms_se = n_se > 0 ? GS_SQRT(se2_sum / n_se) : (gs_real)NAN;
 
@@ -150,9 +152,8 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         for (uint32_t i = 0; i < n; i++) {
             dev[i] = GS_FABSR(v[i] - med);
         }
-        sort_asc(dev, n);
         gs_real corr = n < 10 ? k_mad_corr[n] : (gs_real)n / ((gs_real)n - GS_R(0.8));
-        gs_real spread = MAD_TO_SIGMA * median_sorted(dev, n) * corr;
+        gs_real spread = MAD_TO_SIGMA * gs_sort_median(dev, n) * corr;
         /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
         gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
         gs_real sigma = spread > se_floor ? spread : se_floor;

@@ -7,13 +7,8 @@
 
 #include "gravscale/gs_com.h"
 
-/* one copy of a helper called from several places: smaller code on the Cortex-M4 (where
- * the build optimises for size); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_finite.h"
+#include "gs_inline.h"
 
 #define DROPPED_SEGMENT_WEIGHT 0.02f /* weight factor of a frame whose COM lacks a whole segment */
 
@@ -123,7 +118,7 @@ static const seg_table k_tables[3] = {
  * position is finite (c == 0 is missing even with min_conf 0). */
 static bool kp_usable(const gs_kp *q, float min_conf)
 {
-    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && isfinite(q->x_px) && isfinite(q->y_px);
+    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && gs_finite_f(q->x_px) && gs_finite_f(q->y_px);
 }
 
 static float conf01(float c)
@@ -693,7 +688,7 @@ static void com_result(const frame *f, float total, gs_com_out *out)
      * out of the frame at the apex) biases the renormalised COM by centimetres:
      * such frames count only when nothing better exists */
     if (f->com.w < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
-    if (isfinite(com.x) && isfinite(com.y)) {
+    if (gs_finite_f(com.x) && gs_finite_f(com.y)) {
         out->x_px = com.x;
         out->y_px = com.y;
         out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
@@ -713,10 +708,10 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     if (stature == GS_STATURE_NOSE_ANKLE_117) {
         st = nose_ankle_stature(&f);
     }
-    if (isfinite(st)) { /* else NaN: absurd coordinates overflow float */
+    if (gs_finite_f(st)) { /* else NaN: absurd coordinates overflow float */
         out->stature_px = st;
     }
-    if (!isfinite(up.x) || !isfinite(up.y)) {
+    if (!gs_finite_f(up.x) || !gs_finite_f(up.y)) {
         up = (vec2){ NAN, NAN };
         axis_from_body = false;
     }

@@ -8,14 +8,7 @@
 #include <string.h>
 
 #include "gs_dbits.h"
-
-/* one copy of a helper called from several places: smaller code where the build optimises
- * for size (the firmware); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_inline.h"
 
 /* NMEA 0183 caps a sentence at 82 characters including "$" and CR LF. */
 #define NMEA_MAX 82u

@@ -4,13 +4,8 @@
 #include <math.h>
 #include <string.h>
 
-/* one copy of a helper called from several places: smaller code where the build optimises
- * for size (the firmware); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_finite.h"
+#include "gs_inline.h"
 
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
@@ -30,7 +25,8 @@
 #define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
 #define LAND_G_REL  5.8f   /* gravity in statures per s^2 (9.81 m/s^2 over a 1.7 m body): a landing foot's fall */
 
-static bool fin(float v) { return v == v && v - v == 0.0f; }
+/* one copy: called for nearly every height read */
+static NOINLINE bool fin(float v) { return gs_finite_f(v); }
 
 /* the tracking state of a point, not its logged events */
 static NOINLINE void reset_track(gs_foot *f)
@@ -75,17 +71,20 @@ static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST -
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(ft, 0)] - ft->t_us[slot(ft, back)]; }
 
+/* the point's height `back` frames before the newest */
+static NOINLINE float u_at(const gs_feet *ft, const gs_foot *f, uint32_t back) { return f->u_px[slot(ft, back)]; }
+
 /* The newest crossing of level L by the point within the history, rising (up) or falling,
  * interpolated between the two frames around it; GS_T_NONE when none. */
 static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up)
 {
     uint32_t newer = UINT32_MAX;  /* the newer frame of the pair: a missing or outlier frame is bridged */
     for (uint32_t b = 0; b < held(ft); b++) {
-        float u0 = f->u_px[slot(ft, b)];
+        float u0 = u_at(ft, f, b);
         if (!fin(u0)) continue;
         if (newer != UINT32_MAX) {
-            float u1 = f->u_px[slot(ft, newer)];
-            if (up ? (u0 <= L && u1 > L) : (u0 > L && u1 <= L)) {
+            float u1 = u_at(ft, f, newer);
+            if ((u0 <= L) == up && (u1 <= L) != up) {  /* (both finite) */
                 uint32_t a0 = age_us(ft, b), a1 = age_us(ft, newer);
                 float w = (L - u0) / (u1 - u0);
                 return ft->t_last_us - (int64_t)a0 + (int32_t)(w * (float)(a0 - a1) + 0.5f);
@@ -106,35 +105,41 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
  * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
 static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
 {
-    uint32_t bk[GS_FEET_HIST];  /* finite frames, newest first (a missing or outlier frame is bridged) */
+    float uk[GS_FEET_HIST];     /* finite heights, newest first (a missing or outlier frame is bridged) */
+    uint32_t ak[GS_FEET_HIST];  /* their ages, us */
     unsigned n = 0;
-    for (uint32_t b = 0; b < held(ft); b++)
-        if (fin(f->u_px[slot(ft, b)])) bk[n++] = b;
+    for (uint32_t b = 0; b < held(ft); b++) {
+        float u = u_at(ft, f, b);
+        if (fin(u)) {
+            uk[n] = u;
+            ak[n++] = age_us(ft, b);
+        }
+    }
     unsigned c = n;  /* the first frame at L after the newest crossing */
     for (unsigned i = 0; i + 1 < n && c == n; i++)
-        if (f->u_px[slot(ft, bk[i + 1])] > L && f->u_px[slot(ft, bk[i])] <= L) c = i;
+        if (uk[i + 1] > L && uk[i] <= L) c = i;
     if (c == n) return GS_T_NONE;
     unsigned a = c;  /* the last frame surely in the air before it: clear of L, and not braked */
     for (unsigned i = c + 1; i < n; i++) {
-        float u = f->u_px[slot(ft, bk[i])];
+        float u = uk[i];
         if (!(u > L)) break;  /* (an earlier dip: no clear bracket) */
         if (!(u > L + margin)) continue;
         if (i + 2u < n) {  /* a fall into it under half the one before is no free fall: the impact's blur */
-            float u1 = f->u_px[slot(ft, bk[i + 1u])], u2 = f->u_px[slot(ft, bk[i + 2u])];
-            float t0 = (float)age_us(ft, bk[i]), t1 = (float)age_us(ft, bk[i + 1u]), t2 = (float)age_us(ft, bk[i + 2u]);
+            float u1 = uk[i + 1u], u2 = uk[i + 2u];
+            float t0 = (float)ak[i], t1 = (float)ak[i + 1u], t2 = (float)ak[i + 2u];
             if ((u1 - u) * BRAKE_RATIO * (t2 - t1) < (u2 - u1) * (t1 - t0)) continue;
         }
         a = i;
         break;
     }
     if (a == c) return crossing_us(ft, f, L, false);
-    float ua = f->u_px[slot(ft, bk[a])];
-    float ta = (float)age_us(ft, bk[a]) * 1e-6f, tc = (float)age_us(ft, bk[c]) * 1e-6f;  /* s before the newest */
-    float tau = (ta - tc) * (ua - L) / (ua - f->u_px[slot(ft, bk[c])]);  /* the chord's: the latest */
+    float ua = uk[a];
+    float ta = (float)ak[a] * 1e-6f, tc = (float)ak[c] * 1e-6f;  /* s before the newest */
+    float tau = (ta - tc) * (ua - L) / (ua - uk[c]);  /* the chord's: the latest */
     if (a + 1u < n) {
         /* falling on from its speed between a and the frame before, as a body falls */
-        float g = LAND_G_REL * size_px, tb = (float)age_us(ft, bk[a + 1u]) * 1e-6f;
-        float v = (f->u_px[slot(ft, bk[a + 1u])] - ua) / (tb - ta) + 0.5f * g * (tb - ta);
+        float g = LAND_G_REL * size_px, tb = (float)ak[a + 1u] * 1e-6f;
+        float v = (uk[a + 1u] - ua) / (tb - ta) + 0.5f * g * (tb - ta);
         float disc = v * v + 2.0f * g * (ua - L);
         float tq = disc >= 0.0f ? (sqrtf(disc) - v) / g : NAN;
         if (tq >= 0.0f && tq < tau) tau = tq;
@@ -146,9 +151,9 @@ static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L,
  * (a lone outlier does not move it); the height `back` alone when those are not all known */
 static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
 {
-    float a = f->u_px[slot(ft, back)];
+    float a = u_at(ft, f, back);
     if (back + 3u > held(ft)) return a;
-    float b = f->u_px[slot(ft, back + 1u)], c = f->u_px[slot(ft, back + 2u)];
+    float b = u_at(ft, f, back + 1u), c = u_at(ft, f, back + 2u);
     if (!fin(a) || !fin(b) || !fin(c)) return a;
     if (a > b) { float t = a; a = b; b = t; }
     if (b > c) b = c;
@@ -173,7 +178,7 @@ static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
 {
     if (back + 2 > held(ft)) return NAN;
     uint32_t dt = age_us(ft, back + 1) - age_us(ft, back);
-    return (f->u_px[slot(ft, back)] - f->u_px[slot(ft, back + 1)]) / ((float)dt * 1e-6f);
+    return (u_at(ft, f, back) - u_at(ft, f, back + 1)) / ((float)dt * 1e-6f);
 }
 
 
@@ -243,7 +248,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float m = med3_at(ft, f, 0);
     bool st = still(ft, f, m, size_px);
     if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
-        float d2 = GS_FABS(u - 2.0f * f->u_px[slot(ft, 1)] + f->u_px[slot(ft, 2)]) / 1.954f;
+        float d2 = GS_FABS(u - 2.0f * u_at(ft, f, 1) + u_at(ft, f, 2)) / 1.954f;
         if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
         if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
     }
@@ -281,7 +286,7 @@ static void process_pending(gs_feet *ft, const float *next)
     unsigned s = ft->n % GS_FEET_HIST;
     float size = ft->pend_size_px, spike = SPIKE_REL * size;
     for (int p = 0; p < GS_FEET_POINTS && next && ft->n > 0; p++) {
-        float a = ft->pt[p].u_px[slot(ft, 0)], b = ft->pt[p].u_px[s], c = next[p];
+        float a = u_at(ft, &ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
         if ((b - a > spike && b - c > spike) || (a - b > spike && c - b > spike)) ft->pt[p].u_px[s] = NAN;
     }
     ft->n++;

@@ -6,6 +6,8 @@
 #include <string.h>
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
+#include "gs_finite.h"
+
 
 /* A diagonal of R below this fraction of its column's norm means the column is
  * (numerically) a combination of the previous ones: the design is singular. */
@@ -360,7 +362,7 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
 static bool sample_usable(const gs_sample *s)
 {
     /* w_q > 0 is gs_sample_w(s) > 0 without the division */
-    return s->w_q > 0u && isfinite(s->x_px) && isfinite(s->y_px);
+    return s->w_q > 0u && gs_finite_f(s->x_px) && gs_finite_f(s->y_px);
 }
 
 /* Window sample i unpacked into *out when it is held and usable; false otherwise. */
@@ -1667,7 +1669,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
 static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, uint32_t *keep,
                             gs_fit_result *out)
 {
-    gs_real floor_px = (isfinite(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
+    gs_real floor_px = (gs_finite_f(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
     switch (method) {
     case GS_FIT_PLAIN:
         return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out, NULL);

@@ -32,13 +32,7 @@
 #define DBG(...) ((void)0)
 #endif
 
-/* small helpers called from several places: one copy is smaller than inlining it everywhere
- * (where the build optimises for size); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_inline.h"
 
 
 /* tuning: thresholds in units of the noise or of the object's size */

@@ -5,6 +5,8 @@
 #include <math.h>
 #include <stdbool.h>
 
+#include "gs_finite.h"
+
 #define PI_F      3.14159265358979f
 #define PI_2_F    1.57079632679490f
 #define PI_6_F    0.523598775598299f
@@ -75,7 +77,7 @@ static float reduce(float x, int *quad)
 /* sin(x + quarter_turns pi/2): cos(x) is sin a quarter turn on, so both share one body */
 static float sin_turned(float x, int quarter_turns)
 {
-    if (!isfinite(x)) return x - x;
+    if (!gs_finite_f(x)) return x - x;
     int q;
     float r = reduce(x, &q);
     float z = r * r;

@@ -4,13 +4,8 @@
 #include <math.h>
 #include <string.h>
 
-/* one copy of a helper called from several places: smaller code where the build optimises
- * for size (the firmware); elsewhere the compiler inlines what pays */
-#ifdef __OPTIMIZE_SIZE__
-#define NOINLINE __attribute__((noinline))
-#else
-#define NOINLINE
-#endif
+#include "gs_inline.h"
+#include "gs_median.h"
 
 #define GAP_MAX_US 500000  /* an absence this long (or the absence limit, when shorter) is a gap */
 #define ODD_RUN_NEEDED 6u  /* standing frames off the reference that make a new body (noise is single frames) */
@@ -37,18 +32,9 @@ void gs_session_init(gs_session *s, int64_t absence_us, gs_real new_body_rel)
 /* the median of GS_SESSION_REF_N sizes */
 static gs_real median_ref(const float *v)
 {
-    const uint32_t n = GS_SESSION_REF_N;
-    float t[GS_SESSION_REF_N];
-    for (uint32_t i = 0; i < n; i++) {
-        float x = v[i];
-        uint32_t j = i;
-        while (j > 0 && t[j - 1] > x) {
-            t[j] = t[j - 1];
-            j--;
-        }
-        t[j] = x;
-    }
-    return (n & 1u) ? (gs_real)t[n / 2] : GS_R(0.5) * ((gs_real)t[n / 2 - 1] + (gs_real)t[n / 2]);
+    gs_real t[GS_SESSION_REF_N];
+    for (uint32_t i = 0; i < GS_SESSION_REF_N; i++) t[i] = v[i];
+    return gs_sort_median(t, GS_SESSION_REF_N);
 }
 
 static uint32_t start(gs_session *s, int64_t t_us)
