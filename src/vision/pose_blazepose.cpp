@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "pose_look.hpp"
+#include "warp_crop.hpp"
 
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
@@ -677,8 +678,7 @@ struct PoseTracker::Impl {
     // 2.70 -> 2.61.)
     void crop_roi(const cv::Mat &bgr, const PoseRoi &r)
     {
-        cv::warpAffine(bgr, crop, pose_roi_crop_to_image(r, kLmSide), cv::Size(kLmSide, kLmSide),
-                       cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+        warp_crop_bgr(bgr, pose_roi_crop_to_image(r, kLmSide), kLmSide, crop);
     }
 
     // Landmarks of one ROI into out; the next frame's ROI into *next.
