@@ -252,6 +252,57 @@ static void test_area_reduction_is_opencvs(void)
     TEST_ASSERT_EQUAL_INT(cases, same);
 }
 
+// the same for colour images and a given output size (the pose detector's
+// letterbox: 720 x 1280 -> 360 x 640 -> 126 x 224), the scales per axis
+static void test_area_reduction_to_a_size_is_opencvs(void)
+{
+    std::vector<cv::Mat> imgs;
+    char p_buf[512];
+    std::snprintf(p_buf, sizeof p_buf, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    if (exists(p_buf)) {
+        cv::VideoCapture cap(p_buf);
+        cv::Mat f;
+        for (int i = 0; i < 5 && cap.read(f); i++) imgs.push_back(f.clone());
+    }
+    int cases = 0, same = 0;
+    auto check = [&](const cv::Mat &src, cv::Size ds) {
+        cv::Mat a, b;
+        cv::resize(src, a, ds, 0, 0, cv::INTER_AREA);
+        gs::resize_area(src, b, ds);
+        cases++;
+        same += a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+    };
+    for (const cv::Mat &f : imgs) {
+        cv::Mat half;
+        cv::resize(f, half, cv::Size(f.cols / 2, f.rows / 2), 0, 0, cv::INTER_AREA);
+        check(f, cv::Size(f.cols / 2, f.rows / 2));
+        check(half, cv::Size(126, 224));
+        check(f, cv::Size(126, 224));
+        cv::Mat grey;
+        cv::cvtColor(f, grey, cv::COLOR_BGR2GRAY);
+        check(grey, cv::Size(640, 1138));
+    }
+    cv::RNG rng(9);
+    for (int i = 0; i < 200; i++) {
+        cv::Mat g(rng.uniform(8, 500), rng.uniform(8, 500), i % 2 ? CV_8UC3 : CV_8UC1);
+        rng.fill(g, cv::RNG::UNIFORM, 0, 256);
+        cv::Size ds(rng.uniform(1, g.cols + 1), rng.uniform(1, g.rows + 1));
+        if (i % 10 == 0) ds = cv::Size(g.cols / 2, g.rows / (1 + i % 3));  // whole factors
+        check(g, ds);
+    }
+    // the output written into part of a larger image, as the letterbox is
+    cv::Mat canvas(224, 224, CV_8UC3, cv::Scalar::all(0)), ref = canvas.clone(), src(640, 360, CV_8UC3);
+    rng.fill(src, cv::RNG::UNIFORM, 0, 256);
+    cv::Mat part = canvas(cv::Rect(49, 0, 126, 224)), ref_part = ref(cv::Rect(49, 0, 126, 224));
+    gs::resize_area(src, part, part.size());
+    cv::resize(src, ref_part, ref_part.size(), 0, 0, cv::INTER_AREA);
+    cases++;
+    same += cv::norm(canvas, ref, cv::NORM_INF) == 0.0;
+    std::printf("area reduction to a size: %d of %d images as cv::resize (%d frames of the gym clip)\n", same,
+                cases, static_cast<int>(imgs.size()));
+    TEST_ASSERT_EQUAL_INT(cases, same);
+}
+
 // the corner search gives OpenCV's corners in OpenCV's order: whole frames, cells
 // of a frame (the gradient reads past a cell's edge), masks, both block sizes
 static void test_corners_are_opencvs(void)
@@ -319,6 +370,7 @@ int main(void)
     RUN_TEST(test_real_static_camera);
     RUN_TEST(test_real_handheld_camera);
     RUN_TEST(test_area_reduction_is_opencvs);
+    RUN_TEST(test_area_reduction_to_a_size_is_opencvs);
     RUN_TEST(test_corners_are_opencvs);
     return UNITY_END();
 }

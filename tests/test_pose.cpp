@@ -21,6 +21,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 extern "C" {
 #include "gravscale/gravscale.h"
@@ -28,6 +29,7 @@ extern "C" {
 }
 
 #include "pose_blazepose.hpp"
+#include "warp_crop.hpp"
 
 void setUp(void) {}
 void tearDown(void) {}
@@ -209,6 +211,43 @@ void test_roi_crop_warp_finds_marker(void)
     cv::Point2d p = gs::pose_roi_to_image(r, xn, yn);
     TEST_ASSERT_DOUBLE_WITHIN(0.3, 400.0, p.x);
     TEST_ASSERT_DOUBLE_WITHIN(0.3, 170.0, p.y);
+}
+
+// the landmark network's crop is cv::warpAffine's, pixel for pixel: real frames and
+// random images, crops inside, across and beyond the border, shrunk, enlarged, rotated
+void test_roi_crop_is_opencvs(void)
+{
+    std::vector<cv::Mat> imgs;
+    char p_buf[512];
+    std::snprintf(p_buf, sizeof p_buf, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    cv::VideoCapture cap(p_buf);
+    cv::Mat f;
+    for (int i = 0; i < 4 && cap.read(f); i++) imgs.push_back(f.clone());
+    cv::RNG rng(11);
+    for (int i = 0; i < 6; i++) {
+        cv::Mat g(rng.uniform(3, 400), rng.uniform(3, 400), CV_8UC3);
+        rng.fill(g, cv::RNG::UNIFORM, 0, 256);
+        imgs.push_back(g);
+    }
+    int cases = 0, same = 0;
+    for (const cv::Mat &img : imgs) {
+        for (int i = 0; i < 60; i++) {
+            gs::PoseRoi r;
+            r.cx_px = rng.uniform(-0.3, 1.3) * img.cols;
+            r.cy_px = rng.uniform(-0.3, 1.3) * img.rows;
+            r.size_px = rng.uniform(0.05, 2.0) * std::max(img.cols, img.rows);
+            r.rotation_rad = rng.uniform(-M_PI, M_PI);
+            const int side = i % 7 == 0 ? rng.uniform(1, 300) : 256;
+            cv::Mat m = gs::pose_roi_crop_to_image(r, side), a, b;
+            cv::warpAffine(img, a, m, cv::Size(side, side), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+            gs::warp_crop_bgr(img, m, side, b);
+            cases++;
+            same += a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+        }
+    }
+    std::printf("roi crop: %d of %d crops as cv::warpAffine (%d frames of the gym clip)\n", same, cases,
+                static_cast<int>(imgs.size()) - 6);
+    TEST_ASSERT_EQUAL_INT(cases, same);
 }
 
 // ---- detection decoding -------------------------------------------------------------
@@ -664,6 +703,7 @@ int main(void)
     RUN_TEST(test_roi_rotations);
     RUN_TEST(test_roi_maps_scale_point_to_crop_top);
     RUN_TEST(test_roi_crop_warp_finds_marker);
+    RUN_TEST(test_roi_crop_is_opencvs);
     RUN_TEST(test_letterbox);
     RUN_TEST(test_decode_and_weighted_nms);
     RUN_TEST(test_config_keys);

@@ -98,6 +98,32 @@ inline void sum_across(const float *row, const int *ix, const float *al, int w, 
     }
 }
 
+// two entries per output column: where four columns in a row take four source
+// columns in a row and the four after them (a reduction by less than 2, such as
+// 720 -> 640 px), the same products and sums four at a time (run[q]: the first
+// source column of group q, -1 where the group does not follow that pattern)
+inline void sum_across_2(const float *row, const int *ix, const float *al, const float *al0, const float *al1,
+                         const int *run, int w, float *buf)
+{
+    int dx = 0;
+#ifdef __SSE2__
+    for (int q = 0; dx + 4 <= w; q++, dx += 4) {
+        if (run[q] >= 0) {
+            const __m128 p0 = _mm_mul_ps(_mm_loadu_ps(row + run[q]), _mm_loadu_ps(al0 + dx));
+            const __m128 p1 = _mm_mul_ps(_mm_loadu_ps(row + run[q] + 1), _mm_loadu_ps(al1 + dx));
+            _mm_storeu_ps(buf + dx, _mm_add_ps(p0, p1));
+        } else {
+            sum_across<2>(row, ix + 2 * dx, al + 2 * dx, 4, buf + dx);
+        }
+    }
+#else
+    (void)al0;
+    (void)al1;
+    (void)run;
+#endif
+    sum_across<2>(row, ix + 2 * dx, al + 2 * dx, w - dx, buf + dx);
+}
+
 inline void sum_across_k(const float *row, const int *ix, const float *al, int w, int k, float *buf)
 {
     for (int dx = 0; dx < w; dx++, ix += k, al += k) {
@@ -109,37 +135,49 @@ inline void sum_across_k(const float *row, const int *ix, const float *al, int w
 
 }  // namespace
 
-void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
+namespace {
+
+// cv::resize's INTER_AREA by a factor of at least 1 on both axes, not whole on
+// both (resize.cpp, resizeArea): 8-bit, any number of channels
+void area_reduce(const cv::Mat &src, cv::Mat &dst, cv::Size ds, double scale_x, double scale_y)
 {
-    CV_Assert(src.type() == CV_8UC1 && f > 0.0 && f <= 1.0);
-    // cv::resize's output size and its scale (from f, not from the sizes)
-    cv::Size ds(cv::saturate_cast<int>(src.cols * f), cv::saturate_cast<int>(src.rows * f));
-    const double scale = 1.0 / f;
-    const int iscale = cv::saturate_cast<int>(scale);
-    // OpenCV's own path: a copy, a whole factor, or a CPU whose compiler may fuse a
-    // multiply and an add (FMA), which rounds once where OpenCV's sums round twice
-    if (!kExactAreaSums || ds == src.size() || std::abs(scale - iscale) < DBL_EPSILON || ds.width <= 0 ||
-        ds.height <= 0) {
-        cv::resize(src, dst, cv::Size(), f, f, cv::INTER_AREA);
-        return;
-    }
-    const AreaTab xt = area_tab(src.cols, ds.width, scale), yt = area_tab(src.rows, ds.height, scale);
+    const int cn = src.channels();
+    const AreaTab xt = area_tab(src.cols, ds.width, scale_x), yt = area_tab(src.rows, ds.height, scale_y);
     // the entries of one output column padded to k with weight 0: adding S x 0 = +0 leaves a sum >= 0 as it is
     int k = 0;
     for (int dx = 0; dx < ds.width; dx++) k = std::max(k, xt.first[dx + 1] - xt.first[dx]);
-    std::vector<int> xi(static_cast<size_t>(k) * ds.width);
+    // output value j = dx * cn + c (channels interleaved) sums channel c of its source columns
+    const int w = ds.width * cn;
+    std::vector<int> xi(static_cast<size_t>(k) * w);
     std::vector<float> xa(xi.size(), 0.0f);
     for (int dx = 0; dx < ds.width; dx++) {
         const int a = xt.first[dx], n = xt.first[dx + 1] - a;
-        for (int e = 0; e < k; e++) {
-            xi[static_cast<size_t>(dx) * k + e] = xt.src[a + std::min(e, n - 1)];
-            if (e < n) xa[static_cast<size_t>(dx) * k + e] = xt.alpha[a + e];
+        for (int c = 0; c < cn; c++) {
+            const size_t j = static_cast<size_t>(dx) * cn + c;
+            for (int e = 0; e < k; e++) {
+                xi[j * k + e] = xt.src[a + std::min(e, n - 1)] * cn + c;
+                if (e < n) xa[j * k + e] = xt.alpha[a + e];
+            }
+        }
+    }
+    std::vector<float> xa0(w), xa1(w);
+    std::vector<int> run(static_cast<size_t>(w / 4), -1);
+    if (k == 2) {
+        for (int dx = 0; dx < w; dx++) {
+            xa0[dx] = xa[2 * static_cast<size_t>(dx)];
+            xa1[dx] = xa[2 * static_cast<size_t>(dx) + 1];
+        }
+        for (size_t q = 0; q < run.size(); q++) {
+            const int *ix = &xi[8 * q];
+            bool in_row = true;
+            for (int l = 0; l < 4; l++) in_row = in_row && ix[2 * l] == ix[0] + l && ix[2 * l + 1] == ix[0] + l + 1;
+            if (in_row) run[q] = ix[0];
         }
     }
     cv::Mat out = dst.data == src.data ? cv::Mat() : dst;  // dst's own memory unless it is src's
-    out.create(ds, CV_8UC1);
-    const int w = ds.width;
-    std::vector<float> row(src.cols), buf(w), sum(w);
+    out.create(ds, src.type());
+    const int src_w = src.cols * cn;
+    std::vector<float> row(src_w), buf(w), sum(w);
     int buf_row = -1;
     for (int dy = 0; dy < ds.height; dy++) {
         for (int j = yt.first[dy]; j < yt.first[dy + 1]; j++) {
@@ -149,7 +187,7 @@ void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
                 int x = 0;
 #ifdef __SSE2__
                 const __m128i z = _mm_setzero_si128();
-                for (; x + 16 <= src.cols; x += 16) {
+                for (; x + 16 <= src_w; x += 16) {
                     __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i *>(S + x));
                     __m128i lo = _mm_unpacklo_epi8(v, z), hi = _mm_unpackhi_epi8(v, z);
                     _mm_storeu_ps(&row[x], _mm_cvtepi32_ps(_mm_unpacklo_epi16(lo, z)));
@@ -158,11 +196,13 @@ void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
                     _mm_storeu_ps(&row[x + 12], _mm_cvtepi32_ps(_mm_unpackhi_epi16(hi, z)));
                 }
 #endif
-                for (; x < src.cols; x++) row[x] = S[x];
+                for (; x < src_w; x++) row[x] = S[x];
                 if (k == 3)
                     sum_across<3>(row.data(), xi.data(), xa.data(), w, buf.data());
+                else if (k == 4)
+                    sum_across<4>(row.data(), xi.data(), xa.data(), w, buf.data());
                 else if (k == 2)
-                    sum_across<2>(row.data(), xi.data(), xa.data(), w, buf.data());
+                    sum_across_2(row.data(), xi.data(), xa.data(), xa0.data(), xa1.data(), run.data(), w, buf.data());
                 else
                     sum_across_k(row.data(), xi.data(), xa.data(), w, k, buf.data());
                 buf_row = sy;
@@ -196,6 +236,40 @@ void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
         for (; dx < w; dx++) D[dx] = cv::saturate_cast<uchar>(sum[dx]);
     }
     dst = out;
+}
+
+}  // namespace
+
+void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f)
+{
+    CV_Assert(src.type() == CV_8UC1 && f > 0.0 && f <= 1.0);
+    // cv::resize's output size and its scale (from f, not from the sizes)
+    cv::Size ds(cv::saturate_cast<int>(src.cols * f), cv::saturate_cast<int>(src.rows * f));
+    const double scale = 1.0 / f;
+    const int iscale = cv::saturate_cast<int>(scale);
+    // OpenCV's own path: a copy, a whole factor, or a CPU whose compiler may fuse a
+    // multiply and an add (FMA), which rounds once where OpenCV's sums round twice
+    if (!kExactAreaSums || ds == src.size() || std::abs(scale - iscale) < DBL_EPSILON || ds.width <= 0 ||
+        ds.height <= 0) {
+        cv::resize(src, dst, cv::Size(), f, f, cv::INTER_AREA);
+        return;
+    }
+    area_reduce(src, dst, ds, scale, scale);
+}
+
+void resize_area(const cv::Mat &src, cv::Mat &dst, cv::Size ds)
+{
+    // cv::resize's scales for a given size, and the cases it does not reduce by area sums
+    const double sx = 1.0 / (static_cast<double>(ds.width) / src.cols);
+    const double sy = 1.0 / (static_cast<double>(ds.height) / src.rows);
+    const bool whole = std::abs(sx - cv::saturate_cast<int>(sx)) < DBL_EPSILON &&
+                       std::abs(sy - cv::saturate_cast<int>(sy)) < DBL_EPSILON;
+    if (!kExactAreaSums || src.depth() != CV_8U || src.empty() || ds.width <= 0 || ds.height <= 0 || !(sx >= 1.0) ||
+        !(sy >= 1.0) || whole) {
+        cv::resize(src, dst, ds, 0, 0, cv::INTER_AREA);
+        return;
+    }
+    area_reduce(src, dst, ds, sx, sy);
 }
 
 namespace {

@@ -41,6 +41,9 @@ struct CameraMotionFrame {
 // without OpenCV's per-weight read-modify-write of one accumulator, which makes
 // a non-integer reduction (720 -> 640 px) cost several times a whole-factor one.
 void resize_area_grey(const cv::Mat &src, cv::Mat &dst, double f);
+// cv::resize(src, dst, ds, 0, 0, INTER_AREA) for 8-bit images of any channels,
+// with the same pixels and the same per-axis scales (the pose detector's input)
+void resize_area(const cv::Mat &src, cv::Mat &dst, cv::Size ds);
 
 // Scratch memory of good_features, kept from call to call.
 struct CornerWork {

@@ -214,11 +214,39 @@ private:
 
 FrameSource::~FrameSource() = default;
 
+// at most this many buffers are kept: the frames in flight between the stages
+constexpr size_t kMaxBuffers = 8;
+
+cv::Mat FrameSource::spare_buffer()
+{
+    // only this list holds it: no frame made in it is still in use (other threads drop theirs atomically)
+    for (const cv::Mat &m : buffers_)
+        if (m.u && __atomic_load_n(&m.u->refcount, __ATOMIC_ACQUIRE) == 1) return m;
+    return cv::Mat();
+}
+
+void FrameSource::keep_buffer(const cv::Mat &m)
+{
+    if (!m.u) return;
+    for (const cv::Mat &b : buffers_)
+        if (b.u == m.u) return;
+    for (cv::Mat &b : buffers_) {
+        if (__atomic_load_n(&b.u->refcount, __ATOMIC_ACQUIRE) == 1) {  // one the reader did not write into
+            b = m;
+            return;
+        }
+    }
+    if (buffers_.size() < kMaxBuffers) buffers_.push_back(m);
+}
+
 double FrameSource::rate_from_first_times(size_t n)
 {
     while (prefetch_.size() < n && !eof_) {
         Raw r;
-        if (!read_raw(r.bgr, r.t)) {
+        r.bgr = spare_buffer();
+        bool ok = read_raw(r.bgr, r.t);
+        keep_buffer(r.bgr);
+        if (!ok) {
             eof_ = true;
             break;
         }
@@ -240,7 +268,11 @@ bool FrameSource::next(Frame &f)
         r = std::move(prefetch_.front());
         prefetch_.pop_front();
     } else {
-        if (eof_ || !read_raw(r.bgr, r.t)) {
+        if (eof_) return false;
+        r.bgr = spare_buffer();
+        bool ok = read_raw(r.bgr, r.t);
+        keep_buffer(r.bgr);
+        if (!ok) {
             eof_ = true;
             return false;
         }

@@ -100,6 +100,10 @@ private:
         cv::Mat bgr;
         double t;
     };
+    // the frames' buffers, handed out again once every frame made in them is let go
+    cv::Mat spare_buffer();
+    void keep_buffer(const cv::Mat &m);
+    std::vector<cv::Mat> buffers_;
     std::deque<Raw> prefetch_;
     bool eof_ = false;
     int64_t n_read_ = 0, n_repaired_ = 0;

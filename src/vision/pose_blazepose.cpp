@@ -9,9 +9,12 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <thread>
 #include <sys/stat.h>
 
+#include "camera_motion.hpp"
 #include "pose_look.hpp"
+#include "warp_crop.hpp"
 
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
@@ -585,10 +588,16 @@ struct PoseTracker::Impl {
         return pose_roi_from_alignment(f[0], f[1], f[2], f[3], kRoiScale);
     }
 
-    bool load(std::unique_ptr<PoseNet> &net, const std::string &path)
+    // both networks, the detector's in a thread of its own: compiling them side by
+    // side halves the start-up on two CPUs
+    bool load(const std::string &det_path, const std::string &lm_path)
     {
-        net = pose_net_load(engine, path, cfg.threads, error);
-        return net != nullptr;
+        std::string det_error;
+        std::thread t([&] { det = pose_net_load(engine, det_path, cfg.threads, det_error); });
+        lm = pose_net_load(engine, lm_path, cfg.threads, error);
+        t.join();
+        if (!det) error = det_error;
+        return det && lm;
     }
 
     // Run a zero input once and name the outputs by their shapes.
@@ -648,11 +657,12 @@ struct PoseTracker::Impl {
         // area averaging against aliasing; a whole-factor step first keeps it
         // cheap (1080p: 3 ms instead of 14); both steps map extents to extents
         int k = static_cast<int>(std::floor(0.5 / std::max(lb.scale_x, lb.scale_y)));
+        // (resize_area: cv::resize's pixels, its non-whole factor several times faster)
         if (k >= 2) {
-            cv::resize(bgr, det_half, cv::Size(bgr.cols / k, bgr.rows / k), 0, 0, cv::INTER_AREA);
-            cv::resize(det_half, dst, dst.size(), 0, 0, cv::INTER_AREA);
+            resize_area(bgr, det_half, cv::Size(bgr.cols / k, bgr.rows / k));
+            resize_area(det_half, dst, dst.size());
         } else {
-            cv::resize(bgr, dst, dst.size(), 0, 0, cv::INTER_AREA);
+            resize_area(bgr, dst, dst.size());
         }
         cv::dnn::blobFromImage(rgb_det, blob_det, 1.0 / 127.5, cv::Size(), cv::Scalar::all(127.5), true, false, CV_32F);
         std::vector<cv::Mat> outs;
@@ -670,8 +680,7 @@ struct PoseTracker::Impl {
     // 2.70 -> 2.61.)
     void crop_roi(const cv::Mat &bgr, const PoseRoi &r)
     {
-        cv::warpAffine(bgr, crop, pose_roi_crop_to_image(r, kLmSide), cv::Size(kLmSide, kLmSide),
-                       cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+        warp_crop_bgr(bgr, pose_roi_crop_to_image(r, kLmSide), kLmSide, crop);
     }
 
     // Landmarks of one ROI into out; the next frame's ROI into *next.
@@ -779,7 +788,7 @@ PoseTracker::PoseTracker(const PoseConfig &cfg) : p_(new Impl)
     // OpenCV's pool serves its DNN and the frame's image work (process-wide)
     if (cfg.threads > 0) cv::setNumThreads(cfg.threads);
     const std::string dp = pose_detector_path(cfg), lp = pose_landmark_path(cfg);
-    if (!p_->load(p_->det, dp) || !p_->load(p_->lm, lp)) return;
+    if (!p_->load(dp, lp)) return;
     if (!p_->find_outputs(dp, lp)) return;
     p_->ok = true;
 }

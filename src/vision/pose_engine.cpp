@@ -2,6 +2,9 @@
 #include "pose_engine.hpp"
 
 #include <sched.h>
+#include <sys/stat.h>
+
+#include <cstdlib>
 
 #include <opencv2/dnn.hpp>
 
@@ -107,6 +110,17 @@ int allowed_cpus()
     return n > 0 ? n : 1;
 }
 
+std::string pose_engine_cache_dir()
+{
+    const char *env = std::getenv("GS_POSE_CACHE");
+    if (env) return std::string(env) == "off" ? std::string() : std::string(env);
+    const char *xdg = std::getenv("XDG_CACHE_HOME");
+    if (xdg && *xdg == '/') return std::string(xdg) + "/gravscale/openvino";
+    const char *home = std::getenv("HOME");
+    if (home && *home == '/') return std::string(home) + "/.cache/gravscale/openvino";
+    return std::string();
+}
+
 std::unique_ptr<PoseNet> pose_net_load(PoseEngine e, const std::string &path, int threads, std::string &err)
 {
     e = pose_engine_resolve(e);
@@ -127,22 +141,37 @@ std::unique_ptr<PoseNet> pose_net_load(PoseEngine e, const std::string &path, in
         return n;
     }
 #if GS_HAVE_OPENVINO
-    try {
-        static ov::Core core;  // one per process: it holds the loaded device plugins
-        std::unique_ptr<OpenVinoNet> n(new OpenVinoNet);
-        // f32: the CPU's default bf16/f16 shifts the outputs by ~0.5 %; no pinning: the
-        // machine's other work and taskset decide where the threads run
-        ov::AnyMap props{ov::hint::inference_precision(ov::element::f32),
-                         ov::hint::performance_mode(ov::hint::PerformanceMode::LATENCY),
-                         ov::hint::enable_cpu_pinning(false),
-                         ov::inference_num_threads(threads > 0 ? threads : allowed_cpus())};
-        n->model = core.compile_model(core.read_model(path), "CPU", props);
-        n->req = n->model.create_infer_request();
-        return n;
-    } catch (const std::exception &ex) {
-        err = "cannot load pose model " + path + " in OpenVINO: " + ex.what();
-        return nullptr;
+    static ov::Core core;  // one per process: it holds the loaded device plugins
+    // f32: the CPU's default bf16/f16 shifts the outputs by ~0.5 %; no pinning: the
+    // machine's other work and taskset decide where the threads run
+    ov::AnyMap props{ov::hint::inference_precision(ov::element::f32),
+                     ov::hint::performance_mode(ov::hint::PerformanceMode::LATENCY),
+                     ov::hint::enable_cpu_pinning(false),
+                     ov::inference_num_threads(threads > 0 ? threads : allowed_cpus())};
+    // OpenVINO keys a file's cache entry by its path: its size and time name a folder
+    // of their own, so a model converted again is compiled again
+    std::string cache = pose_engine_cache_dir();
+    struct stat st;
+    if (!cache.empty() && stat(path.c_str(), &st) == 0)
+        cache += "/" + std::to_string(static_cast<long long>(st.st_size)) + "-" +
+                 std::to_string(static_cast<long long>(st.st_mtim.tv_sec)) + "." +
+                 std::to_string(static_cast<long long>(st.st_mtim.tv_nsec));
+    else
+        cache.clear();
+    for (int cached = cache.empty() ? 0 : 1; cached >= 0; cached--) {
+        try {
+            std::unique_ptr<OpenVinoNet> n(new OpenVinoNet);
+            ov::AnyMap p = props;
+            if (cached) p.emplace(ov::cache_dir.name(), cache);
+            n->model = core.compile_model(path, "CPU", p);
+            n->req = n->model.create_infer_request();
+            return n;
+        } catch (const std::exception &ex) {
+            // a cache that cannot be written or read: compiled without it
+            if (!cached) err = "cannot load pose model " + path + " in OpenVINO: " + ex.what();
+        }
     }
+    return nullptr;
 #else
     (void)threads;
     err = "this build has no OpenVINO (tools/fetch_engine.sh installs it, then configure again)";
