@@ -3,7 +3,8 @@
  * same pipeline with trace events on, whose closes run whole in the landing's frame (trace
  * events keep the stream's order); its trace lines are left out of the comparison. A
  * COCO-17 body (the feet wait with the samples) jumps in place; the streams end, pause or
- * wrap a small ring at every frame around a landing, and jumps follow each other closely. */
+ * wrap a small ring at every frame around a landing, jumps follow each other closely, and
+ * seeds leave their widest core fit to the next frame. */
 #include "unity.h"
 #include "gravscale/gravscale.h"
 
@@ -65,6 +66,7 @@ static double rise_at(const jumps *j, double t, bool *air)
 }
 
 typedef struct {
+    int seed_waits;               /* frames that left a seed's widest core to the next */
     char out[OUT_MAX];
     size_t len;
     long frame;                   /* the frame being pushed */
@@ -91,6 +93,8 @@ typedef struct {
     long frames;          /* frames pushed, then the stream ends */
     long pause_after;     /* after this frame a pause beyond the ring's time span (-1: none) */
     bool point;           /* the COM alone (the point layout: no feet, the contact model times the flight) */
+    double noise_px;      /* keypoint noise, 1 sigma (0: 1 px) */
+    double outliers;      /* the share of frames whose body is displaced by up to 40 px */
 } stream;
 
 static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(double) + 8];
@@ -107,7 +111,7 @@ static void run(const jumps *j, const stream *st, bool at_once, capture *cap)
                                               sizeof storage, on_event, cap));
     gs_pipeline_set_trace(&p, at_once);
     rng = 88172645463325252ull;
-    const double stature_px = 600.0, q = 1.75 / stature_px;
+    const double stature_px = 600.0, q = 1.75 / stature_px, noise = st->noise_px > 0.0 ? st->noise_px : 1.0;
     int64_t pause_us = 0;
     for (long i = 0; i < st->frames; i++) {
         double t = (double)i / st->fps;
@@ -124,14 +128,22 @@ static void run(const jumps *j, const stream *st, bool at_once, capture *cap)
             continue;
         }
         gs_kp kp[17];
+        double ox = 0.0, oy = 0.0;
+        if (urand() < st->outliers) {
+            ox = 40.0 * (2.0 * urand() - 1.0);
+            oy = 40.0 * (2.0 * urand() - 1.0);
+        }
         for (int k = 0; k < 17; k++) {
             /* the ankles stay on the floor through the countermovement */
             double r = k >= 15 ? (air ? rise : 0.0) : rise;
-            kp[k].x_px = (float)(960.0 + kp_x[k] * stature_px + 1.0 * nrand());
-            kp[k].y_px = (float)(900.0 - (kp_h[k] * 1.75 + r) / q + 1.0 * nrand());
+            kp[k].x_px = (float)(960.0 + ox + kp_x[k] * stature_px + noise * nrand());
+            kp[k].y_px = (float)(900.0 + oy - (kp_h[k] * 1.75 + r) / q + noise * nrand());
             kp[k].c = 0.9f;
         }
         TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_push_keypoints_us(&p, gs_time_us_of_s(t) + pause_us, kp));
+#if GS_CLOSE_LAG_FRAMES > 0
+        cap->seed_waits += p.flight.close.stage == GS_CLOSE_SEED;
+#endif
         if (i == st->pause_after) pause_us = GS_RING_SPAN_US + 1000000;
     }
     cap->frame = st->frames;
@@ -168,7 +180,7 @@ static int landings(const jumps *j, const stream *st, long *frame)
 static void test_jumps_120fps(void)
 {
     jumps j = {1.0, 0.5, 1.2, 4};
-    stream st = {120.0, 512, (long)(8.0 * 120.0), -1, false};
+    stream st = {120.0, 512, (long)(8.0 * 120.0), -1, false, 0.0, 0.0};
     long frame[JUMPS_MAX];
     TEST_ASSERT_EQUAL_INT(4, landings(&j, &st, frame));
     TEST_ASSERT_TRUE(compare(&j, &st) > 0);  /* the closes did wait */
@@ -179,7 +191,7 @@ static void test_jumps_120fps(void)
 static void test_stream_ends_while_pending(void)
 {
     jumps j = {1.0, 0.5, 1.2, 2};
-    stream st = {120.0, 512, (long)(5.0 * 120.0), -1, false};
+    stream st = {120.0, 512, (long)(5.0 * 120.0), -1, false, 0.0, 0.0};
     long frame[JUMPS_MAX];
     TEST_ASSERT_EQUAL_INT(2, landings(&j, &st, frame));
     long delayed = 0;
@@ -200,7 +212,7 @@ static void test_jumps_close_together(void)
     for (unsigned a = 0; a < sizeof fps / sizeof fps[0]; a++)
         for (unsigned b = 0; b < sizeof contact_s / sizeof contact_s[0]; b++) {
             jumps j = {1.0, 0.45, contact_s[b], 5};
-            stream st = {fps[a], 512, (long)(6.0 * fps[a]), -1, false};
+            stream st = {fps[a], 512, (long)(6.0 * fps[a]), -1, false, 0.0, 0.0};
             compare(&j, &st);
         }
 }
@@ -209,7 +221,7 @@ static void test_jumps_close_together(void)
 static void test_break_after_landing(void)
 {
     jumps j = {1.0, 0.5, 1.2, 2};
-    stream st = {120.0, 512, (long)(5.0 * 120.0), -1, false};
+    stream st = {120.0, 512, (long)(5.0 * 120.0), -1, false, 0.0, 0.0};
     long frame[JUMPS_MAX];
     TEST_ASSERT_EQUAL_INT(2, landings(&j, &st, frame));
     for (long at = frame[0] - 2; at <= frame[0] + GS_CLOSE_LAG_FRAMES + 2; at++) {
@@ -225,7 +237,7 @@ static void test_break_after_landing(void)
 static void test_point_layout(void)
 {
     jumps j = {1.0, 0.5, 0.3, 3};
-    stream st = {120.0, 512, (long)(5.0 * 120.0), -1, true};
+    stream st = {120.0, 512, (long)(5.0 * 120.0), -1, true, 0.0, 0.0};
     long frame[JUMPS_MAX];
     TEST_ASSERT_EQUAL_INT(3, landings(&j, &st, frame));
     TEST_ASSERT_TRUE(compare(&j, &st) > 0);
@@ -236,6 +248,25 @@ static void test_point_layout(void)
     }
 }
 
+/* Frames whose body jumps by up to 40 px (5-30 %): seeds whose narrower cores do not hold try
+ * the widest in the next frame (the lines as when all are tried at once). */
+static void test_seed_widest_core_next_frame(void)
+{
+    static capture got;
+    static const double outliers[] = {0.05, 0.1, 0.2, 0.3};
+    static const double flight_s[] = {0.25, 0.35, 0.45};
+    int waits = 0;
+    for (unsigned a = 0; a < sizeof outliers / sizeof outliers[0]; a++)
+        for (unsigned b = 0; b < sizeof flight_s / sizeof flight_s[0]; b++) {
+            jumps j = {1.0, flight_s[b], 1.0, 3};
+            stream st = {120.0, 512, (long)(6.0 * 120.0), -1, false, 2.0, outliers[a]};
+            compare(&j, &st);
+            run(&j, &st, false, &got);
+            waits += got.seed_waits;
+        }
+    TEST_ASSERT_TRUE(waits > 0);  /* the widest cores did wait */
+}
+
 static void test_small_ring(void)
 {
     static const unsigned ring[] = {64, 128};
@@ -244,7 +275,7 @@ static void test_small_ring(void)
         for (unsigned m = 0; m < sizeof flight_s / sizeof flight_s[0]; m++)
             for (int point = 0; point < 2; point++) {
                 jumps j = {1.0, flight_s[m], 0.3, 3};
-                stream st = {120.0, ring[k], (long)(4.0 * 120.0), -1, point != 0};
+                stream st = {120.0, ring[k], (long)(4.0 * 120.0), -1, point != 0, 0.0, 0.0};
                 compare(&j, &st);
             }
 }
@@ -257,6 +288,7 @@ int main(void)
     RUN_TEST(test_jumps_close_together);
     RUN_TEST(test_break_after_landing);
     RUN_TEST(test_point_layout);
+    RUN_TEST(test_seed_widest_core_next_frame);
     RUN_TEST(test_small_ring);
     return UNITY_END();
 }

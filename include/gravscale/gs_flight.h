@@ -51,9 +51,22 @@ typedef struct {
 } gs_fit_memo;
 #endif
 
-/* A flight's close in progress: where it stands and what its steps pass on. */
+/* A flight's close in steps, each bounded: one robust fit or the boundary search */
+typedef enum {
+    GS_CLOSE_NONE = 0,  /* nothing pending */
+    GS_CLOSE_REFIT,     /* rebuild the running fit over the flight */
+    GS_CLOSE_START,     /* solve it and start the take-off side's walk */
+    GS_CLOSE_GROW,      /* the walk (an alarm's refit a step) */
+    GS_CLOSE_GROWN,     /* refit the grown flight */
+    GS_CLOSE_BOUNDS,    /* the take-off and landing times */
+    GS_CLOSE_FINAL,     /* the final fit and the event */
+    GS_CLOSE_SEED       /* not a close: a seed's widest core */
+} gs_close_stage;
+
+/* A flight's close in progress (or a seed's widest core): where it stands and what its
+ * steps pass on. */
 typedef struct {
-    uint8_t stage;             /* 0: none pending */
+    uint8_t stage;             /* gs_close_stage */
     bool truncated;            /* the flight ended without its landing (a gap, the stream's end) */
     bool alarm_due;            /* the take-off side's walk stopped at an alarm awaiting its refit */
     uint32_t newest;           /* the newest sample examined when the flight ended */
@@ -73,6 +86,8 @@ typedef struct {
     uint32_t in_lo, in_hi;     /* the final fit's samples */
 #if GS_CLOSE_LAG_FRAMES > 0
     gs_fit_memo memo;
+    uint32_t apex;             /* a seed's apex (its core widths are tried one a frame too) */
+    uint8_t width;             /* ... the next width to try */
     /* while it waits: no frame it holds back may be one the standing tracker takes */
     uint32_t checked;          /* the next waiting sample to check */
     uint32_t n_ground;         /* the usable samples among those checked */

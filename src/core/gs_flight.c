@@ -89,9 +89,6 @@
 #define GRAV_DIR_SE_K    GS_R(2.0)    /* gravity's direction may differ from the expected by this many SE ... */
 #define GRAV_DIR_MIN_DEG GS_R(8.0)    /* ... plus this (a standing body's axis leans a few degrees, most seen from the side) */
 
-/* A flight's close in steps (gs_close.stage), each bounded: one robust fit or the boundary search */
-enum { CLOSE_NONE = 0, CLOSE_REFIT, CLOSE_START, CLOSE_GROW, CLOSE_GROWN, CLOSE_BOUNDS, CLOSE_FINAL };
-
 /* isfinite of a gs_real (or float) value, in one place */
 static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
 
@@ -322,8 +319,8 @@ void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS]
 #if GS_CLOSE_LAG_FRAMES > 0
     /* a pending close reads the feet as they were at the landing: the frames since wait
      * with their samples (a full hold: a caller that skips gs_flight_update) */
-    if (f->close.stage != CLOSE_NONE && f->feet_held_n == GS_CLOSE_LAG_FRAMES) close_finish(f);
-    if (f->close.stage != CLOSE_NONE) {
+    if (f->close.stage != GS_CLOSE_NONE && f->feet_held_n == GS_CLOSE_LAG_FRAMES) close_finish(f);
+    if (f->close.stage != GS_CLOSE_NONE) {
         gs_feet_frame *h = &f->feet_held[f->feet_held_n++];
         h->t_us = t_us;
         memcpy(h->x_px, x_px, sizeof h->x_px);
@@ -671,12 +668,15 @@ static bool seed_core_width(gs_flight *f, uint32_t apex, uint32_t newest, int64_
     return true;
 }
 
+/* the seed's core half-widths, tried in turn: wider when noise hides the curve */
+static const int32_t seed_half_us[] = {CORE_HALF_US, CORE_HALF_US * 145 / 100, CORE_HALF_US * 19 / 10};
+#define SEED_WIDTHS (sizeof seed_half_us / sizeof seed_half_us[0])
+
 /* Seed a flight at an apex: fit a core around it, wider when noise hides the curve. */
 static bool seed_core(gs_flight *f, uint32_t apex, uint32_t newest)
 {
-    static const int32_t half_us[] = {CORE_HALF_US, CORE_HALF_US * 145 / 100, CORE_HALF_US * 19 / 10};
-    for (unsigned k = 0; k < sizeof half_us / sizeof half_us[0]; k++)
-        if (seed_core_width(f, apex, newest, half_us[k])) return true;
+    for (unsigned k = 0; k < SEED_WIDTHS; k++)
+        if (seed_core_width(f, apex, newest, seed_half_us[k])) return true;
     return false;
 }
 
@@ -1010,7 +1010,7 @@ static gs_real rigid_size(const gs_flight *f, uint32_t lo, uint32_t hi, gs_real 
  * Every sample but gross outliers enters the running fit (so a biased early
  * fit corrects itself); the flight's edge is the last sample after which the
  * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end
- * (CLOSE_GROWN). all: walk to the end; else stop after an alarm's refit, or before
+ * (GS_CLOSE_GROWN). all: walk to the end; else stop after an alarm's refit, or before
  * one once the walk took WALK_FREE samples. True when it ran a refit or stopped for one. */
 static bool grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all)
 {
@@ -1024,7 +1024,7 @@ static bool grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all)
             uint32_t i = c->walk_i;
             if (!alarm_is_false(f, m, i, f->fl_last, i, -1)) {
                 c->left_alarm = i;
-                c->stage = CLOSE_GROWN;
+                c->stage = GS_CLOSE_GROWN;
                 return true;
             }
             c->clean = i;
@@ -1059,7 +1059,7 @@ static bool grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all)
         gs_fit_solve(&f->fit, &c->r);
         if (c->cusum == GS_R(0.0)) c->clean = i;
     }
-    c->stage = c->clean != f->fl_first ? CLOSE_GROWN : CLOSE_BOUNDS;
+    c->stage = c->clean != f->fl_first ? GS_CLOSE_GROWN : GS_CLOSE_BOUNDS;
     return false;
 }
 
@@ -1167,10 +1167,10 @@ static void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
     f->quiet_from = c->newest;
     if (land_idx != GS_NO_IDX && land_idx < c->newest) f->quiet_from = land_idx;
     restart_levels(f, c->newest);  /* next seeds start after the landing */
-    c->stage = CLOSE_NONE;
+    c->stage = GS_CLOSE_NONE;
 }
 
-/* CLOSE_START: the flight's fit as grown so far, and the take-off side's walk from its first sample */
+/* GS_CLOSE_START: the flight's fit as grown so far, and the take-off side's walk from its first sample */
 static void close_start(gs_flight *f, gs_close *c)
 {
     if (gs_fit_solve(&f->fit, &c->r) != GS_OK) {
@@ -1183,10 +1183,10 @@ static void close_start(gs_flight *f, gs_close *c)
     c->t_prev_us = t_at(f, f->fl_first);
     c->left_alarm = GS_NO_IDX;
     c->alarm_due = false;
-    c->stage = CLOSE_GROW;
+    c->stage = GS_CLOSE_GROW;
 }
 
-/* CLOSE_BOUNDS: the take-off and landing times (the feet's, else the COM's contact model)
+/* GS_CLOSE_BOUNDS: the take-off and landing times (the feet's, else the COM's contact model)
  * and the samples of the final fit */
 static void close_bounds(gs_flight *f, gs_close *c)
 {
@@ -1258,10 +1258,10 @@ static void close_bounds(gs_flight *f, gs_close *c)
     c->in_hi = trim_edge(f, hi, c->in_lo, W1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
-    c->stage = CLOSE_FINAL;
+    c->stage = GS_CLOSE_FINAL;
 }
 
-/* CLOSE_FINAL: the final robust fit over the flight's samples, the judgement and the event */
+/* GS_CLOSE_FINAL: the final robust fit over the flight's samples, the judgement and the event */
 static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
 {
     uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
@@ -1422,6 +1422,8 @@ done:
     close_done(f, c, land_idx);
 }
 
+static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t);
+
 /* Take the close's steps: all of them (all), else until one has run a robust fit or the
  * boundary search. */
 static void close_run(gs_flight *f, gs_close *c, bool all)
@@ -1432,26 +1434,37 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
     fit_memo memo = {0}, *m = &memo;  /* (every step in this call) */
 #endif
     bool spent = false;
-    while (c->stage != CLOSE_NONE && (all || !spent)) {
+    while (c->stage != GS_CLOSE_NONE && (all || !spent)) {
         switch (c->stage) {
-        case CLOSE_REFIT: {  /* the running fit may hold samples past the edge: rebuild it over the flight */
+        case GS_CLOSE_REFIT: {  /* the running fit may hold samples past the edge: rebuild it over the flight */
             gs_fit_result r;
             refit_range(f, m, f->fl_first, f->fl_last, &r);
-            c->stage = CLOSE_START;
+            c->stage = GS_CLOSE_START;
             spent = true;
             break;
         }
-        case CLOSE_START: close_start(f, c); break;
-        case CLOSE_GROW: spent = grow_left_step(f, c, m, all); break;
-        case CLOSE_GROWN: {
+        case GS_CLOSE_START: close_start(f, c); break;
+        case GS_CLOSE_GROW: spent = grow_left_step(f, c, m, all); break;
+        case GS_CLOSE_GROWN: {
             f->fl_first = c->clean;
             gs_fit_result rr;  /* r changes only when the refit succeeds */
             if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, &c->r);
-            c->stage = CLOSE_BOUNDS;
+            c->stage = GS_CLOSE_BOUNDS;
             spent = true;
             break;
         }
-        case CLOSE_BOUNDS: close_bounds(f, c); spent = true; break;
+        case GS_CLOSE_BOUNDS: close_bounds(f, c); spent = true; break;
+#if GS_CLOSE_LAG_FRAMES > 0
+        case GS_CLOSE_SEED:
+            spent = true;
+            if (seed_core_width(f, c->apex, c->newest, seed_half_us[c->width])) {
+                c->stage = GS_CLOSE_NONE;
+                seed_found(f, c->newest, t_at(f, c->apex));  /* (its landing may begin a close) */
+            } else if (++c->width == SEED_WIDTHS) {
+                c->stage = GS_CLOSE_NONE;
+            }
+            break;
+#endif
         default: close_final(f, c, m); break;
         }
     }
@@ -1466,7 +1479,7 @@ static void close_begin(gs_flight *f, gs_close *c, uint32_t newest, uint32_t rig
     c->right_alarm = right_alarm;
     c->truncated = truncated;
     c->head = idx_of(f, gs_ring_head(f->ring));
-    c->stage = refit ? CLOSE_REFIT : CLOSE_START;
+    c->stage = refit ? GS_CLOSE_REFIT : GS_CLOSE_START;
 #if GS_CLOSE_LAG_FRAMES > 0
     c->memo.valid = false;
 #endif
@@ -1581,6 +1594,58 @@ static void close_now(gs_flight *f, uint32_t newest, uint32_t right_alarm, bool 
 /* ---- the per-sample state machine ------------------------------------------ */
 
 static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s);
+
+/* The seed holds: airborne from its apex; samples after the core that arrived meanwhile
+ * (through newest) are tested in order */
+static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t)
+{
+    set_state(f, GS_FS_AIRBORNE, apex_t);
+    for (uint32_t i = f->fl_last + 1; i <= newest && f->state == GS_FS_AIRBORNE; i++) {
+        gs_sample_full p_b;
+        const gs_sample_full *p = usable_at(f, i, &p_b);
+        if (p) airborne_sample(f, i, p);
+    }
+}
+
+#if GS_CLOSE_LAG_FRAMES > 0
+/* A job that waits for the next frames (a close or a seed, its newest sample at t_us): no
+ * sample is examined meanwhile, n_ground: usable samples since the levels restarted (see
+ * may_stand), low: the oldest sample it may read */
+static void job_wait(gs_flight *f, gs_close *c, int64_t t_us, uint32_t n_ground, uint32_t low)
+{
+    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
+    c->head = idx_of(f, gs_ring_head(f->ring));
+    c->t_end_us = t_us;
+    c->low = low > oldest ? low : oldest;
+    c->checked = f->next;
+    c->n_ground = n_ground;
+    c->dt_q4 = f->dt_med_q4;
+    c->t_last_us = f->last_t_us;
+    /* a stillness goes on from when it began, or begins after now */
+    c->still_after_us = f->still_since_us != GS_T_NONE ? f->still_since_us : t_us;
+}
+
+/* Seed a flight at an apex (ground_sample): the two narrower core widths now, the widest
+ * in the next frame (GS_CLOSE_SEED; at once when that frame could be a standing one, as it is
+ * when the "apex" was a standing body's noise) */
+#define SEED_WIDTHS_NOW 2
+static void seed_begin(gs_flight *f, uint32_t apex, uint32_t newest, int64_t apex_t, int64_t t_us)
+{
+    for (unsigned k = 0; k < SEED_WIDTHS_NOW; k++)
+        if (seed_core_width(f, apex, newest, seed_half_us[k])) {
+            seed_found(f, newest, apex_t);
+            return;
+        }
+    gs_close *c = &f->close;
+    c->stage = GS_CLOSE_SEED;
+    c->apex = apex;
+    c->width = SEED_WIDTHS_NOW;
+    c->newest = newest;
+    /* (the levels run on, and a flight may be seeded next: no sample is spared the test) */
+    job_wait(f, c, t_us, 4u, history_floor(f));
+    if (close_due(f)) close_run(f, c, true);
+}
+#endif
 
 /* |du/dt| against the sample about lag_us back (frame jitter is not motion); NaN unknown */
 static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full *s, gs_real u, int64_t lag_us)
@@ -1755,15 +1820,13 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
     uint32_t apex = f->peak_idx;
     int64_t apex_t = f->peak_t_us;
     f->peak_u = -INFINITY;
-    if (seed_core(f, apex, idx)) {
-        set_state(f, GS_FS_AIRBORNE, apex_t);
-        /* samples after the core that arrived meanwhile are tested in order */
-        for (uint32_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
-            gs_sample_full p_b;
-            const gs_sample_full *p = usable_at(f, i, &p_b);
-            if (p) airborne_sample(f, i, p);
-        }
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (!f->trace) {
+        seed_begin(f, apex, idx, apex_t, s->t_us);
+        return;
     }
+#endif
+    if (seed_core(f, apex, idx)) seed_found(f, idx, apex_t);
 }
 
 static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_full *s)
@@ -1781,21 +1844,13 @@ static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_ful
     if (!f->trace) {
         gs_close *c = &f->close;
         close_begin(f, c, idx, alarm, false, true);
-        c->t_end_us = s->t_us;
-        uint32_t floor_idx = history_floor(f), oldest = idx_of(f, gs_ring_oldest(f->ring));
-        uint32_t low = f->fl_first < floor_idx ? f->fl_first : floor_idx;
-        c->low = low > oldest ? low : oldest;
-        c->checked = f->next;
-        c->n_ground = 0;
-        c->dt_q4 = f->dt_med_q4;
-        c->t_last_us = f->last_t_us;
-        /* still now: its stillness may go on; else one begins only after the landing */
-        c->still_after_us = f->still_since_us == GS_T_NONE ? s->t_us : GS_T_NONE;
+        uint32_t floor_idx = history_floor(f);
+        job_wait(f, c, s->t_us, 0u, f->fl_first < floor_idx ? f->fl_first : floor_idx);
         if (!close_due(f)) {  /* its steps in the next frames */
             set_state(f, GS_FS_GROUND, s->t_us);
             return;
         }
-        c->stage = CLOSE_NONE;
+        c->stage = GS_CLOSE_NONE;
     }
 #endif
     close_now(f, idx, alarm, false, true);
@@ -1874,7 +1929,7 @@ static NOINLINE void rebase(gs_flight *f)
         offsetof(gs_flight, close.newest), offsetof(gs_flight, close.head), offsetof(gs_flight, close.low),
         offsetof(gs_flight, close.right_alarm), offsetof(gs_flight, close.left_alarm),
         offsetof(gs_flight, close.walk_i), offsetof(gs_flight, close.clean),
-        offsetof(gs_flight, close.in_lo), offsetof(gs_flight, close.in_hi),
+        offsetof(gs_flight, close.in_lo), offsetof(gs_flight, close.in_hi), offsetof(gs_flight, close.apex),
 #endif
     };
     uint64_t head = gs_ring_head(f->ring);
@@ -1920,7 +1975,7 @@ static void examine(gs_flight *f)
         if (f->state == GS_FS_AIRBORNE) airborne_sample(f, idx, s);
         else ground_sample(f, idx, s);
 #if GS_CLOSE_LAG_FRAMES > 0
-        if (f->close.stage != CLOSE_NONE) return;  /* the rest waits for it */
+        if (f->close.stage != GS_CLOSE_NONE) return;  /* the rest waits for it */
 #endif
     }
 #if GS_CLOSE_LAG_FRAMES > 0
@@ -1932,7 +1987,7 @@ static void examine(gs_flight *f)
 /* Finish a pending close now, and any a later sample begins, examining what waited */
 static void close_finish(gs_flight *f)
 {
-    while (f->close.stage != CLOSE_NONE) {
+    while (f->close.stage != GS_CLOSE_NONE) {
         close_run(f, &f->close, true);
         examine(f);
     }
@@ -1943,9 +1998,9 @@ void gs_flight_update(gs_flight *f)
 {
     rebase(f);
 #if GS_CLOSE_LAG_FRAMES > 0
-    if (f->close.stage != CLOSE_NONE) {
+    if (f->close.stage != GS_CLOSE_NONE) {
         close_run(f, &f->close, close_due(f));
-        if (f->close.stage != CLOSE_NONE) return;
+        if (f->close.stage != GS_CLOSE_NONE) return;
     }
 #endif
     examine(f);
