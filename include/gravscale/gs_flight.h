@@ -33,8 +33,8 @@ typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 
 /* Frames a flight's close may spread over, one robust fit or boundary search a frame (and
  * at most 60 ms): the flight module then lags the stream by that many frames and holds
- * their feet (GS_FEET_POINTS points and the size, 28 B a frame). 0: every close runs whole
- * in its landing's frame (the firmware: its state budget has no room for the lag). */
+ * their feet (GS_FEET_POINTS points, the size and the time: 32 B a frame). 0: every close
+ * runs whole in its landing's frame (the firmware: its state budget has no room for the lag). */
 #ifndef GS_CLOSE_LAG_FRAMES
 #define GS_CLOSE_LAG_FRAMES 8
 #endif
@@ -68,26 +68,25 @@ typedef enum {
 typedef struct {
     uint8_t stage;             /* gs_close_stage */
     bool truncated;            /* the flight ended without its landing (a gap, the stream's end) */
-    bool alarm_due;            /* the take-off side's walk stopped at an alarm awaiting its refit */
+    bool feet;                 /* the feet timed the flight (F0_us, F1_us) */
+    bool feet_contradict, fell;
     uint32_t newest;           /* the newest sample examined when the flight ended */
     uint32_t head;             /* the ring's head then: contact samples are looked for below it */
-    uint32_t low;              /* the oldest sample the close may read (it must stay in the ring) */
     uint32_t right_alarm, left_alarm; /* the contact alarms after and before the flight, GS_NO_IDX none */
-    int64_t t_end_us;          /* the time of the sample newest */
-    /* the take-off side's walk (grow_left) */
-    uint32_t walk_i, clean, outliers;
-    gs_real cusum;
-    int64_t t_prev_us;
-    gs_fit_result r;           /* the flight's fit as grown */
-    /* the boundaries */
-    int64_t T0_us, T1_us, F0_us, F1_us;
-    float floor_off_px, floor_on_px, floor_before_px;
-    bool feet_contradict, fell;
+    uint32_t walk_i, clean, outliers; /* the take-off side's walk (grow_left) */
     uint32_t in_lo, in_hi;     /* the final fit's samples */
+    gs_real cusum;             /* ... the walk's */
+    float floor_off_px, floor_on_px, floor_before_px;
+    int64_t t_prev_us;         /* ... the walk's */
+    int64_t T0_us, T1_us, F0_us, F1_us; /* the boundaries */
+    gs_fit_result r;           /* the flight's fit as grown */
 #if GS_CLOSE_LAG_FRAMES > 0
     gs_fit_memo memo;
-    uint32_t apex;             /* a seed's apex (its core widths are tried one a frame too) */
-    uint8_t width;             /* ... the next width to try */
+    uint32_t low;              /* the oldest sample it may read (it must stay in the ring) */
+    int64_t t_end_us;          /* the time of the sample newest */
+    bool alarm_due;            /* the take-off side's walk stopped at an alarm awaiting its refit */
+    uint32_t apex;             /* a seed's apex (GS_CLOSE_SEED: its widest core is tried in a frame of its own) */
+    uint8_t width;             /* ... the core width to try */
     /* while it waits: no frame it holds back may be one the standing tracker takes */
     uint32_t checked;          /* the next waiting sample to check */
     uint32_t n_ground;         /* the usable samples among those checked */

@@ -7,6 +7,8 @@
  * ring history when the flight closes. Take-off and landing are then refined
  * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
  * the boundary) and the final robust 2D fit uses only samples in free flight.
+ * On hosts the close runs in bounded steps over the frames after the landing
+ * (gs_close): no sample is examined meanwhile, so each step reads the landing's state.
  *
  * Numbers: every value (u, noise, levels, CUSUM, sizes, fits, boundary models,
  * apex, SE, q, height) is gs_real: float on the M4 (single-precision FPU), double
@@ -259,7 +261,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
     if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP) return GS_EINVAL;
-    memset(f, 0, sizeof *f);
+    memset(f, 0, sizeof *f);  /* (GS_FS_IDLE, no frame interval, no feet, no close pending) */
     f->cfg = cfg;
     f->ring = ring;
     f->keep = keep;
@@ -271,21 +273,17 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->max_flight_us = gs_time_us_of_cfg_s(cfg->max_flight_s);
     f->max_gap_us = gs_time_us_of_cfg_s(cfg->max_gap_s);
     f->landing_latency_us = gs_time_us_of_cfg_s(cfg->landing_latency_s);
-    f->state = GS_FS_IDLE;
     uint64_t head = gs_ring_head(ring);
     f->base = head > GS_FLIGHT_IDX_KEEP ? head - GS_FLIGHT_IDX_KEEP : 0u;
     f->next = idx_of(f, head);
     f->quiet_from = f->next;
     f->last_t_us = GS_T_NONE;
-    f->up_x = GS_R(0.0);
-    f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
+    f->up_y = -GS_R(1.0);  /* image up (0, -1) until the body axis or a flight says otherwise */
     f->noise_px = NAN;
     restart_levels(f, GS_NO_IDX);  /* no level seen yet */
-    f->dt_med_q4 = 0;               /* no frame interval seen yet */
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
-    f->feet_on = false;
     gs_feet_init(&f->feet, 0.0f, true);
     f->last_land_us = GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
@@ -299,17 +297,26 @@ void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch)
     gs_feet_init(&f->feet, delta_rel, stop_touch);
 }
 
-/* the frame's feet into the feet's tracker, along the up direction of now */
-static void feet_push(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
-                      const float y_px[GS_FEET_POINTS], float size_px)
-{
-    /* the standing size scales the thresholds; before one is known, the frame's own */
-    gs_real size = f->stand_n > 0 ? (gs_real)last_stand_size(f) : (gs_real)size_px;
-    gs_feet_push(&f->feet, t_us, x_px, y_px, f->up_x, f->up_y, size);
-}
-
 #if GS_CLOSE_LAG_FRAMES > 0
 static void close_finish(gs_flight *f);
+
+/* A pending job reads the feet as they were when it began: the frames since wait with
+ * their samples (out of the frame's common path). A full hold: a caller skips
+ * gs_flight_update. */
+static __attribute__((cold, noinline)) void feet_hold(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
+                                                      const float y_px[GS_FEET_POINTS], float size_px)
+{
+    if (f->feet_held_n == GS_CLOSE_LAG_FRAMES) {
+        close_finish(f);  /* (no job pends after it) */
+        gs_flight_feet(f, t_us, x_px, y_px, size_px);
+        return;
+    }
+    gs_feet_frame *h = &f->feet_held[f->feet_held_n++];
+    h->t_us = t_us;
+    memcpy(h->x_px, x_px, sizeof h->x_px);
+    memcpy(h->y_px, y_px, sizeof h->y_px);
+    h->size_px = size_px;
+}
 #endif
 
 void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
@@ -317,19 +324,14 @@ void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS]
 {
     if (!GS_WITH_POSE || !f || !f->feet_on) return;
 #if GS_CLOSE_LAG_FRAMES > 0
-    /* a pending close reads the feet as they were at the landing: the frames since wait
-     * with their samples (a full hold: a caller that skips gs_flight_update) */
-    if (f->close.stage != GS_CLOSE_NONE && f->feet_held_n == GS_CLOSE_LAG_FRAMES) close_finish(f);
     if (f->close.stage != GS_CLOSE_NONE) {
-        gs_feet_frame *h = &f->feet_held[f->feet_held_n++];
-        h->t_us = t_us;
-        memcpy(h->x_px, x_px, sizeof h->x_px);
-        memcpy(h->y_px, y_px, sizeof h->y_px);
-        h->size_px = size_px;
+        feet_hold(f, t_us, x_px, y_px, size_px);
         return;
     }
 #endif
-    feet_push(f, t_us, x_px, y_px, size_px);
+    /* the standing size scales the thresholds; before one is known, the frame's own */
+    gs_real size = f->stand_n > 0 ? (gs_real)last_stand_size(f) : (gs_real)size_px;
+    gs_feet_push(&f->feet, t_us, x_px, y_px, f->up_x, f->up_y, size);
 }
 
 /* ---- per-flight helpers ---------------------------------------------------- */
@@ -498,12 +500,18 @@ static gs_real gate_size(const gs_flight *f, uint32_t idx)
 #endif
 }
 
-/* the fit's apex: where its velocity along its own gravity is zero (GS_T_NONE unknown) */
-static int64_t fit_apex_us(const gs_fit_result *r)
+/* the fit's apex: where its velocity along its own gravity is zero, seconds after its t0 */
+static gs_real fit_apex_s(const gs_fit_result *r)
 {
     gs_real gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
     gs_real v_down = r->vx_px_s * gx + r->vy_px_s * gy;
-    return gs_time_add_s(r->t0_us, -v_down / r->a_px_s2);
+    return -v_down / r->a_px_s2;  /* after the fit's t0 */
+}
+
+/* ... as a time (GS_T_NONE unknown) */
+static int64_t fit_apex_us(const gs_fit_result *r)
+{
+    return gs_time_add_s(r->t0_us, fit_apex_s(r));
 }
 
 /* the fit's height at t along its own up (against its acceleration), px */
@@ -1017,47 +1025,57 @@ static bool grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all)
     uint32_t floor_idx = history_floor(f);
     int64_t t_seed = t_at(f, f->seed_idx);
     uint32_t walked = 0;
+#if GS_CLOSE_LAG_FRAMES > 0
+    bool due = c->alarm_due;  /* the walk stopped at an alarm: its refit first */
+    c->alarm_due = false;
+#else
+    bool due = false;
+#endif
     for (;;) {
-        if (c->alarm_due) {
-            if (!all && walked > WALK_FREE) return true;  /* its refit in the next step */
-            c->alarm_due = false;
-            uint32_t i = c->walk_i;
-            if (!alarm_is_false(f, m, i, f->fl_last, i, -1)) {
-                c->left_alarm = i;
-                c->stage = GS_CLOSE_GROWN;
+        if (!due) {
+            if (c->walk_i <= floor_idx) break;
+            uint32_t i = --c->walk_i;
+            gs_sample_full s_b;
+            const gs_sample_full *s = at(f, i, &s_b);
+            if (!s) break;
+            if (!usable(s)) continue;
+            if (span_over(c->t_prev_us, s->t_us, f->max_gap_us)) break;
+            if (span_over(t_seed, s->t_us, f->max_flight_us)) break;
+            c->t_prev_us = s->t_us;
+            walked++;
+            gs_real z;
+            if (!test_sample(f, &c->r, s, &z)) {
+                if (++c->outliers > 2) break;
+                continue;
+            }
+            c->outliers = 0;
+            c->cusum = cusum_step(c->cusum, z);
+            if (!(c->cusum > CUSUM_H && z > CUSUM_K)) {
+                fit_add(f, s);
+                gs_fit_solve(&f->fit, &c->r);
+                if (c->cusum == GS_R(0.0)) c->clean = i;
+                continue;
+            }
+#if GS_CLOSE_LAG_FRAMES > 0
+            if (!all && walked > WALK_FREE) {  /* its refit in the next step */
+                c->alarm_due = true;
                 return true;
             }
-            c->clean = i;
-            f->fl_first = i;
-            c->cusum = GS_R(0.0);
-            gs_fit_solve(&f->fit, &c->r);
-            if (!all) return true;
-            continue;
+#endif
         }
-        if (c->walk_i <= floor_idx) break;
-        uint32_t i = --c->walk_i;
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
-        if (!s) break;
-        if (!usable(s)) continue;
-        if (span_over(c->t_prev_us, s->t_us, f->max_gap_us)) break;
-        if (span_over(t_seed, s->t_us, f->max_flight_us)) break;
-        c->t_prev_us = s->t_us;
-        walked++;
-        gs_real z;
-        if (!test_sample(f, &c->r, s, &z)) {
-            if (++c->outliers > 2) break;
-            continue;
+        due = false;
+        /* contact at walk_i, or a refit through it shows a false alarm */
+        uint32_t i = c->walk_i;
+        if (!alarm_is_false(f, m, i, f->fl_last, i, -1)) {
+            c->left_alarm = i;
+            c->stage = GS_CLOSE_GROWN;
+            return true;
         }
-        c->outliers = 0;
-        c->cusum = cusum_step(c->cusum, z);
-        if (c->cusum > CUSUM_H && z > CUSUM_K) {
-            c->alarm_due = true;
-            continue;
-        }
-        fit_add(f, s);
+        c->clean = i;
+        f->fl_first = i;
+        c->cusum = GS_R(0.0);
         gs_fit_solve(&f->fit, &c->r);
-        if (c->cusum == GS_R(0.0)) c->clean = i;
+        if (!all) return true;
     }
     c->stage = c->clean != f->fl_first ? GS_CLOSE_GROWN : GS_CLOSE_BOUNDS;
     return false;
@@ -1164,8 +1182,7 @@ static NOINLINE void restart_levels(gs_flight *f, uint32_t i)
  * contact samples that follow it */
 static void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
 {
-    f->quiet_from = c->newest;
-    if (land_idx != GS_NO_IDX && land_idx < c->newest) f->quiet_from = land_idx;
+    f->quiet_from = land_idx < c->newest ? land_idx : c->newest;  /* (GS_NO_IDX is above every index) */
     restart_levels(f, c->newest);  /* next seeds start after the landing */
     c->stage = GS_CLOSE_NONE;
 }
@@ -1182,7 +1199,9 @@ static void close_start(gs_flight *f, gs_close *c)
     c->cusum = GS_R(0.0);
     c->t_prev_us = t_at(f, f->fl_first);
     c->left_alarm = GS_NO_IDX;
+#if GS_CLOSE_LAG_FRAMES > 0
     c->alarm_due = false;
+#endif
     c->stage = GS_CLOSE_GROW;
 }
 
@@ -1193,7 +1212,8 @@ static void close_bounds(gs_flight *f, gs_close *c)
     const gs_fit_result *r = &c->r;
     /* boundary refinement on the up direction of the flight's own acceleration */
     gs_real save_ux = f->up_x, save_uy = f->up_y;
-    if (finite_r(r->a_px_s2) && r->a_px_s2 > GS_R(0.0)) {
+    bool falls = finite_r(r->a_px_s2) && r->a_px_s2 > GS_R(0.0);
+    if (falls) {
         f->up_x = -r->ax_px_s2 / r->a_px_s2;
         f->up_y = -r->ay_px_s2 / r->a_px_s2;
     }
@@ -1203,7 +1223,7 @@ static void close_bounds(gs_flight *f, gs_close *c)
     c->F0_us = c->F1_us = GS_T_NONE;
     c->feet_contradict = false;  /* the feet, in view, show no flight there */
     c->fell = false;             /* ... or a fall to a lower floor */
-    if (GS_WITH_POSE && f->feet_on && finite_r(r->a_px_s2) && r->a_px_s2 > GS_R(0.0)) {
+    if (GS_WITH_POSE && f->feet_on && falls) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
@@ -1226,17 +1246,18 @@ static void close_bounds(gs_flight *f, gs_close *c)
                               (F0 != GS_T_NONE && F1 == GS_T_NONE && gs_feet_airborne(&f->feet));
         /* a fall: the feet went well below the floor they left (a box): after a clean take-off
          * below its floor, else below the floor they had rested on */
-        float d_px = f->feet.delta_rel * (float)gate_size(f, L);
+        float size_px = (float)gate_size(f, L);
+        float d_px = f->feet.delta_rel * size_px;
         /* (toes stop where they land: after it a squat's or a moving camera's frames are no
          * floor; an ankle's recrossing is above the floor it then comes down to) */
         float low_px = F1 != GS_T_NONE && f->feet.stop_touch ? c->floor_on_px : gs_feet_low_px(&f->feet);
-        c->fell = F0 != GS_T_NONE ? low_px < c->floor_off_px - d_px - FALL_FLOOR_REL * (float)gate_size(f, L)
+        c->fell = F0 != GS_T_NONE ? low_px < c->floor_off_px - d_px - FALL_FLOOR_REL * size_px
                                : gs_feet_sank_since(&f->feet, c0);
     }
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
-    bool feet = c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    bool feet = c->feet = c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
     bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
     gs_real sig = fit_sigma(f, r);
     gs_real pen = DROP_PENALTY * sig * sig;
@@ -1298,7 +1319,7 @@ static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
     if (T0 == GS_T_NONE) T0 = sf->t_us - half_dt;
     if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
-    bool feet = c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    bool feet = c->feet;
     if (feet) {  /* (one end from the feet and the other from the COM would mix two definitions) */
         T0 = c->F0_us;
         T1 = c->F1_us;
@@ -1329,10 +1350,7 @@ static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
         j->rms_px = fr.rms_px;
         gs_real q = g / fr.a_px_s2, height = NAN;
         j->q_m_per_px = q;
-        /* apex: where the velocity along gravity is zero */
-        gs_real gx = fr.ax_px_s2 / fr.a_px_s2, gy = fr.ay_px_s2 / fr.a_px_s2;
-        gs_real v_down = fr.vx_px_s * gx + fr.vy_px_s * gy;
-        gs_real apex_s = -v_down / fr.a_px_s2;  /* after the fit's t0 */
+        gs_real apex_s = fit_apex_s(&fr);
         j->t_apex_us = gs_time_add_s(fr.t0_us, apex_s);
         gs_real rise_t = gs_time_span_s(fr.t0_us, T0) + apex_s;
         j->jump_height_m = g * j->flight_time_s * j->flight_time_s / GS_R(8.0);
@@ -1565,13 +1583,14 @@ static bool close_due(gs_flight *f)
     return false;
 }
 
-/* The held feet of the frames up to t_us into the feet's tracker (the frame's sample is examined next) */
+/* The held feet of the frames up to t_us into the feet's tracker (the frame's sample is
+ * examined next; no job pends) */
 static void feet_release(gs_flight *f, int64_t t_us)
 {
     uint32_t n = 0;
     while (n < f->feet_held_n && f->feet_held[n].t_us <= t_us) {
         const gs_feet_frame *h = &f->feet_held[n++];
-        feet_push(f, h->t_us, h->x_px, h->y_px, h->size_px);
+        gs_flight_feet(f, h->t_us, h->x_px, h->y_px, h->size_px);  /* (no job pends: pushed) */
     }
     if (n == 0) return;
     f->feet_held_n -= n;
@@ -1953,7 +1972,7 @@ static void examine(gs_flight *f)
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
 #if GS_CLOSE_LAG_FRAMES > 0
-        if (s) feet_release(f, s->t_us);
+        if (s && f->feet_held_n > 0) feet_release(f, s->t_us);
 #endif
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
@@ -1979,7 +1998,7 @@ static void examine(gs_flight *f)
 #endif
     }
 #if GS_CLOSE_LAG_FRAMES > 0
-    feet_release(f, INT64_MAX);
+    if (f->feet_held_n > 0) feet_release(f, INT64_MAX);
 #endif
 }
 
