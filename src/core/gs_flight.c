@@ -1219,10 +1219,12 @@ static void close_bounds(gs_flight *f, gs_close *c)
     }
     uint32_t L = f->fl_first, R = f->fl_last;
     /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
-    c->floor_off_px = c->floor_on_px = c->floor_before_px = NAN;
-    c->F0_us = c->F1_us = GS_T_NONE;
-    c->feet_contradict = false;  /* the feet, in view, show no flight there */
-    c->fell = false;             /* ... or a fall to a lower floor */
+    if (GS_WITH_POSE) {  /* (read only where a layout shows feet) */
+        c->floor_off_px = c->floor_on_px = c->floor_before_px = NAN;
+        c->F0_us = c->F1_us = GS_T_NONE;
+        c->feet_contradict = false;  /* the feet, in view, show no flight there */
+        c->fell = false;             /* ... or a fall to a lower floor */
+    }
     if (GS_WITH_POSE && f->feet_on && falls) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
@@ -1257,7 +1259,7 @@ static void close_bounds(gs_flight *f, gs_close *c)
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
-    bool feet = c->feet = c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    bool feet = c->feet = GS_WITH_POSE && c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
     bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
     gs_real sig = fit_sigma(f, r);
     gs_real pen = DROP_PENALTY * sig * sig;
@@ -1319,10 +1321,11 @@ static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
     if (T0 == GS_T_NONE) T0 = sf->t_us - half_dt;
     if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
-    bool feet = c->feet;
+    bool feet = GS_WITH_POSE && c->feet;  /* (no layout with feet: their code folds away) */
+    int64_t F1 = GS_WITH_POSE ? c->F1_us : GS_T_NONE;
     if (feet) {  /* (one end from the feet and the other from the COM would mix two definitions) */
         T0 = c->F0_us;
-        T1 = c->F1_us;
+        T1 = F1;
     }
 
     gs_event ev;
@@ -1383,14 +1386,14 @@ static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
         gs_real gsize = finite_r(size) ? size : gate_size(f, in_lo);
         bool flight_like = plausible_fall(f, &fr, gsize);
         if (!flight_like) goto done;
-        f->last_land_us = c->F1_us != GS_T_NONE ? c->F1_us : T1;  /* (a fall's landing is the feet's, for the rebound's contact) */
+        f->last_land_us = F1 != GS_T_NONE ? F1 : T1;  /* (a fall's landing is the feet's, for the rebound's contact) */
         /* a body measured without a size: its flight is still a flight (its height unknown) */
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
 
-        if (c->fell || (c->F1_us != GS_T_NONE && finite_r(gsize) && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
+        if ((GS_WITH_POSE && c->fell) || (F1 != GS_T_NONE && finite_r(gsize) && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
-        else if (c->feet_contradict)
+        else if (GS_WITH_POSE && c->feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;
         else if (n_in < f->cfg->min_samples || T1 - T0 < f->min_flight_us)
             j->reason = GS_REJ_FEW_SAMPLES;
