@@ -1259,7 +1259,8 @@ static void close_bounds(gs_flight *f, gs_close *c)
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
-    bool feet = c->feet = GS_WITH_POSE && c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    bool feet = GS_WITH_POSE && c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    if (GS_WITH_POSE) c->feet = feet;
     bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
     gs_real sig = fit_sigma(f, r);
     gs_real pen = DROP_PENALTY * sig * sig;
