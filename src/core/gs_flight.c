@@ -1020,7 +1020,7 @@ static gs_real rigid_size(const gs_flight *f, uint32_t lo, uint32_t hi, gs_real 
  * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end
  * (GS_CLOSE_GROWN). all: walk to the end; else stop after an alarm's refit, or before
  * one once the walk took WALK_FREE samples. True when it ran a refit or stopped for one. */
-static bool grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all)
+static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, bool *spent)
 {
     uint32_t floor_idx = history_floor(f);
     int64_t t_seed = t_at(f, f->seed_idx);
@@ -1059,26 +1059,26 @@ static bool grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all)
 #if GS_CLOSE_LAG_FRAMES > 0
             if (!all && walked > WALK_FREE) {  /* its refit in the next step */
                 c->alarm_due = true;
-                return true;
+                *spent = true;
+                return GS_CLOSE_GROW;
             }
 #endif
         }
         due = false;
         /* contact at walk_i, or a refit through it shows a false alarm */
         uint32_t i = c->walk_i;
+        *spent = true;
         if (!alarm_is_false(f, m, i, f->fl_last, i, -1)) {
             c->left_alarm = i;
-            c->stage = GS_CLOSE_GROWN;
-            return true;
+            return GS_CLOSE_GROWN;
         }
         c->clean = i;
         f->fl_first = i;
         c->cusum = GS_R(0.0);
         gs_fit_solve(&f->fit, &c->r);
-        if (!all) return true;
+        if (!all) return GS_CLOSE_GROW;
     }
-    c->stage = c->clean != f->fl_first ? GS_CLOSE_GROWN : GS_CLOSE_BOUNDS;
-    return false;
+    return c->clean != f->fl_first ? GS_CLOSE_GROWN : GS_CLOSE_BOUNDS;
 }
 
 /* Contact samples past the flight edge (side -1: before take-off, +1: after
@@ -1184,15 +1184,14 @@ static void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
 {
     f->quiet_from = land_idx < c->newest ? land_idx : c->newest;  /* (GS_NO_IDX is above every index) */
     restart_levels(f, c->newest);  /* next seeds start after the landing */
-    c->stage = GS_CLOSE_NONE;
 }
 
 /* GS_CLOSE_START: the flight's fit as grown so far, and the take-off side's walk from its first sample */
-static void close_start(gs_flight *f, gs_close *c)
+static uint8_t close_start(gs_flight *f, gs_close *c)
 {
     if (gs_fit_solve(&f->fit, &c->r) != GS_OK) {
         close_done(f, c, GS_NO_IDX);
-        return;
+        return GS_CLOSE_NONE;
     }
     c->walk_i = c->clean = f->fl_first;
     c->outliers = 0;
@@ -1202,12 +1201,12 @@ static void close_start(gs_flight *f, gs_close *c)
 #if GS_CLOSE_LAG_FRAMES > 0
     c->alarm_due = false;
 #endif
-    c->stage = GS_CLOSE_GROW;
+    return GS_CLOSE_GROW;
 }
 
 /* GS_CLOSE_BOUNDS: the take-off and landing times (the feet's, else the COM's contact model)
  * and the samples of the final fit */
-static void close_bounds(gs_flight *f, gs_close *c)
+static uint8_t close_bounds(gs_flight *f, gs_close *c)
 {
     const gs_fit_result *r = &c->r;
     /* boundary refinement on the up direction of the flight's own acceleration */
@@ -1282,11 +1281,11 @@ static void close_bounds(gs_flight *f, gs_close *c)
     c->in_hi = trim_edge(f, hi, c->in_lo, W1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
-    c->stage = GS_CLOSE_FINAL;
+    return GS_CLOSE_FINAL;
 }
 
 /* GS_CLOSE_FINAL: the final robust fit over the flight's samples, the judgement and the event */
-static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
+static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
 {
     uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
     int64_t T0 = c->T0_us, T1 = c->T1_us;
@@ -1442,6 +1441,7 @@ static void close_final(gs_flight *f, gs_close *c, fit_memo *m)
 
 done:
     close_done(f, c, land_idx);
+    return GS_CLOSE_NONE;
 }
 
 static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t);
@@ -1456,40 +1456,43 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
     fit_memo memo = {0}, *m = &memo;  /* (every step in this call) */
 #endif
     bool spent = false;
-    while (c->stage != GS_CLOSE_NONE && (all || !spent)) {
-        switch (c->stage) {
+    uint8_t stage = c->stage;
+    while (stage != GS_CLOSE_NONE && (all || !spent)) {
+        switch (stage) {
         case GS_CLOSE_REFIT: {  /* the running fit may hold samples past the edge: rebuild it over the flight */
             gs_fit_result r;
             refit_range(f, m, f->fl_first, f->fl_last, &r);
-            c->stage = GS_CLOSE_START;
+            stage = GS_CLOSE_START;
             spent = true;
             break;
         }
-        case GS_CLOSE_START: close_start(f, c); break;
-        case GS_CLOSE_GROW: spent = grow_left_step(f, c, m, all); break;
+        case GS_CLOSE_START: stage = close_start(f, c); break;
+        case GS_CLOSE_GROW: stage = grow_left_step(f, c, m, all, &spent); break;
         case GS_CLOSE_GROWN: {
             f->fl_first = c->clean;
             gs_fit_result rr;  /* r changes only when the refit succeeds */
             if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, &c->r);
-            c->stage = GS_CLOSE_BOUNDS;
+            stage = GS_CLOSE_BOUNDS;
             spent = true;
             break;
         }
-        case GS_CLOSE_BOUNDS: close_bounds(f, c); spent = true; break;
+        case GS_CLOSE_BOUNDS: stage = close_bounds(f, c); spent = true; break;
 #if GS_CLOSE_LAG_FRAMES > 0
         case GS_CLOSE_SEED:
             spent = true;
             if (seed_core_width(f, c->apex, c->newest, seed_half_us[c->width])) {
                 c->stage = GS_CLOSE_NONE;
                 seed_found(f, c->newest, t_at(f, c->apex));  /* (its landing may begin a close) */
+                stage = c->stage;
             } else if (++c->width == SEED_WIDTHS) {
-                c->stage = GS_CLOSE_NONE;
+                stage = GS_CLOSE_NONE;
             }
             break;
 #endif
-        default: close_final(f, c, m); break;
+        default: stage = close_final(f, c, m); break;
         }
     }
+    c->stage = stage;
 }
 
 /* Begin closing the open candidate. right_alarm: the sample at which contact was
