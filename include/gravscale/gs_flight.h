@@ -31,6 +31,78 @@ const char *gs_flight_state_name(gs_flight_state s);
 
 typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 
+/* Frames a flight's close may spread over, one robust fit or boundary search a frame (and
+ * at most 60 ms): the flight module then lags the stream by that many frames and holds
+ * their feet (GS_FEET_POINTS points, the size and the time: 32 B a frame). 0: every close
+ * runs whole in its landing's frame (the firmware: its state budget has no room for the lag). */
+#ifndef GS_CLOSE_LAG_FRAMES
+#define GS_CLOSE_LAG_FRAMES 8
+#endif
+
+#if GS_CLOSE_LAG_FRAMES > 0
+/* The last robust fit of a close (gs_flight.c): the same window fitted again gets its result */
+typedef struct {
+    bool valid;
+    uint32_t first, count;
+    float min_scale;
+    gs_fit_method method;
+    gs_status st;
+    gs_fit_result r;
+} gs_fit_memo;
+#endif
+
+/* A flight's close in steps, each bounded: one robust fit or the boundary search */
+typedef enum {
+    GS_CLOSE_NONE = 0,  /* nothing pending */
+    GS_CLOSE_REFIT,     /* rebuild the running fit over the flight */
+    GS_CLOSE_START,     /* solve it and start the take-off side's walk */
+    GS_CLOSE_GROW,      /* the walk (an alarm's refit a step) */
+    GS_CLOSE_GROWN,     /* refit the grown flight */
+    GS_CLOSE_BOUNDS,    /* the take-off and landing times */
+    GS_CLOSE_FINAL,     /* the final fit and the event */
+    GS_CLOSE_SEED       /* not a close: a seed's widest core */
+} gs_close_stage;
+
+/* A flight's close in progress (or a seed's widest core): where it stands and what its
+ * steps pass on. */
+typedef struct {
+    uint8_t stage;             /* gs_close_stage */
+    bool truncated;            /* the flight ended without its landing (a gap, the stream's end) */
+    bool feet;                 /* the feet timed the flight (F0_us, F1_us) */
+    bool feet_contradict, fell;
+    uint32_t newest;           /* the newest sample examined when the flight ended */
+    uint32_t head;             /* the ring's head then: contact samples are looked for below it */
+    uint32_t right_alarm, left_alarm; /* the contact alarms after and before the flight, GS_NO_IDX none */
+    uint32_t walk_i, clean, outliers; /* the take-off side's walk (grow_left) */
+    uint32_t in_lo, in_hi;     /* the final fit's samples */
+    gs_real cusum;             /* ... the walk's */
+    float floor_off_px, floor_on_px, floor_before_px;
+    int64_t t_prev_us;         /* ... the walk's */
+    int64_t T0_us, T1_us, F0_us, F1_us; /* the boundaries */
+    gs_fit_result r;           /* the flight's fit as grown */
+#if GS_CLOSE_LAG_FRAMES > 0
+    gs_fit_memo memo;
+    uint32_t low;              /* the oldest sample it may read (it must stay in the ring) */
+    int64_t t_end_us;          /* the time of the sample newest */
+    bool alarm_due;            /* the take-off side's walk stopped at an alarm awaiting its refit */
+    uint32_t apex;             /* a seed's apex (GS_CLOSE_SEED: its widest core is tried in a frame of its own) */
+    uint8_t width;             /* ... the core width to try */
+    /* while it waits: no frame it holds back may be one the standing tracker takes */
+    uint32_t checked;          /* the next waiting sample to check */
+    uint32_t n_ground;         /* the usable samples among those checked */
+    uint32_t dt_q4;            /* the frame interval as the checked samples will leave it */
+    int64_t t_last_us;         /* ... and the time of the newest present one */
+    int64_t still_after_us;    /* a stillness can only begin after this, GS_T_NONE unknown */
+#endif
+} gs_close;
+
+#if GS_CLOSE_LAG_FRAMES > 0
+typedef struct {               /* a frame's feet (gs_flight_feet) held while a close is pending */
+    int64_t t_us;
+    float x_px[GS_FEET_POINTS], y_px[GS_FEET_POINTS], size_px;
+} gs_feet_frame;
+#endif
+
 typedef struct {
     const gs_core_config *cfg;
     const gs_ring *ring;
@@ -97,6 +169,11 @@ typedef struct {
     int64_t last_land_us;      /* the latest landing (of a jump or a fall), GS_T_NONE none */
     int64_t feet_wait_us;      /* the COM landed: wait until then for the feet, GS_T_NONE not waiting */
     uint32_t wait_alarm;       /* ... the contact alarm it landed with */
+#if GS_CLOSE_LAG_FRAMES > 0
+    gs_close close;            /* the pending close: no sample is examined until it is done */
+    gs_feet_frame feet_held[GS_CLOSE_LAG_FRAMES]; /* the feet of the frames since, oldest first */
+    uint32_t feet_held_n;
+#endif
 } gs_flight;
 
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
@@ -109,7 +186,9 @@ void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch);
 void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
                     const float y_px[GS_FEET_POINTS], float size_px);
 /* Examine every sample pushed to the ring since the last call. Emits GS_EV_JUMP
- * events through on_event (and trace events when f->trace). */
+ * events through on_event (and trace events when f->trace). Call it once per pushed
+ * sample: a pending close takes one step, and the samples wait in the ring (its event
+ * leaves up to GS_CLOSE_LAG_FRAMES frames or 60 ms later, the same events in the same order). */
 void gs_flight_update(gs_flight *f);
 /* The stream pauses longer than the ring's time span (GS_RING_SPAN_US): close
  * an open candidate now, while the ring still holds its samples. */

@@ -7,6 +7,8 @@
  * ring history when the flight closes. Take-off and landing are then refined
  * to sub-frame times with a piecewise model (parabola plus 1/2 da (t-T)^2 past
  * the boundary) and the final robust 2D fit uses only samples in free flight.
+ * On hosts the close runs in bounded steps over the frames after the landing
+ * (gs_close): no sample is examined meanwhile, so each step reads the landing's state.
  *
  * Numbers: every value (u, noise, levels, CUSUM, sizes, fits, boundary models,
  * apex, SE, q, height) is gs_real: float on the M4 (single-precision FPU), double
@@ -253,7 +255,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
     if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP) return GS_EINVAL;
-    memset(f, 0, sizeof *f);
+    memset(f, 0, sizeof *f);  /* (GS_FS_IDLE, no frame interval, no feet, no close pending) */
     f->cfg = cfg;
     f->ring = ring;
     f->keep = keep;
@@ -265,21 +267,17 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->max_flight_us = gs_time_us_of_cfg_s(cfg->max_flight_s);
     f->max_gap_us = gs_time_us_of_cfg_s(cfg->max_gap_s);
     f->landing_latency_us = gs_time_us_of_cfg_s(cfg->landing_latency_s);
-    f->state = GS_FS_IDLE;
     uint64_t head = gs_ring_head(ring);
     f->base = head > GS_FLIGHT_IDX_KEEP ? head - GS_FLIGHT_IDX_KEEP : 0u;
     f->next = idx_of(f, head);
     f->quiet_from = f->next;
     f->last_t_us = GS_T_NONE;
-    f->up_x = GS_R(0.0);
-    f->up_y = -GS_R(1.0);  /* image up until the body axis or a flight says otherwise */
+    f->up_y = -GS_R(1.0);  /* image up (0, -1) until the body axis or a flight says otherwise */
     f->noise_px = NAN;
     restart_levels(f, GS_NO_IDX);  /* no level seen yet */
-    f->dt_med_q4 = 0;               /* no frame interval seen yet */
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
-    f->feet_on = false;
     gs_feet_init(&f->feet, 0.0f, true);
     f->last_land_us = GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
@@ -293,10 +291,38 @@ void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch)
     gs_feet_init(&f->feet, delta_rel, stop_touch);
 }
 
+#if GS_CLOSE_LAG_FRAMES > 0
+static void close_finish(gs_flight *f);
+
+/* A pending job reads the feet as they were when it began: the frames since wait with
+ * their samples (out of the frame's common path). A full hold: a caller skips
+ * gs_flight_update. */
+static __attribute__((cold, noinline)) void feet_hold(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
+                                                      const float y_px[GS_FEET_POINTS], float size_px)
+{
+    if (f->feet_held_n == GS_CLOSE_LAG_FRAMES) {
+        close_finish(f);  /* (no job pends after it) */
+        gs_flight_feet(f, t_us, x_px, y_px, size_px);
+        return;
+    }
+    gs_feet_frame *h = &f->feet_held[f->feet_held_n++];
+    h->t_us = t_us;
+    memcpy(h->x_px, x_px, sizeof h->x_px);
+    memcpy(h->y_px, y_px, sizeof h->y_px);
+    h->size_px = size_px;
+}
+#endif
+
 void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
                     const float y_px[GS_FEET_POINTS], float size_px)
 {
     if (!GS_WITH_POSE || !f || !f->feet_on) return;
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (f->close.stage != GS_CLOSE_NONE) {
+        feet_hold(f, t_us, x_px, y_px, size_px);
+        return;
+    }
+#endif
     /* the standing size scales the thresholds; before one is known, the frame's own */
     gs_real size = f->stand_n > 0 ? (gs_real)last_stand_size(f) : (gs_real)size_px;
     gs_feet_push(&f->feet, t_us, x_px, y_px, f->up_x, f->up_y, size);
@@ -468,12 +494,18 @@ static gs_real gate_size(const gs_flight *f, uint32_t idx)
 #endif
 }
 
-/* the fit's apex: where its velocity along its own gravity is zero (GS_T_NONE unknown) */
-static int64_t fit_apex_us(const gs_fit_result *r)
+/* the fit's apex: where its velocity along its own gravity is zero, seconds after its t0 */
+static gs_real fit_apex_s(const gs_fit_result *r)
 {
     gs_real gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
     gs_real v_down = r->vx_px_s * gx + r->vy_px_s * gy;
-    return gs_time_add_s(r->t0_us, -v_down / r->a_px_s2);
+    return -v_down / r->a_px_s2;  /* after the fit's t0 */
+}
+
+/* ... as a time (GS_T_NONE unknown) */
+static int64_t fit_apex_us(const gs_fit_result *r)
+{
+    return gs_time_add_s(r->t0_us, fit_apex_s(r));
 }
 
 /* the fit's height at t along its own up (against its acceleration), px */
@@ -523,6 +555,9 @@ static NOINLINE uint32_t history_floor(const gs_flight *f)
 /* The last robust fit of one decision (a landing and its close): the same window fitted
  * again gets its result, and f->keep still holds its flags (every robust fit in
  * between goes through the memo). */
+#if GS_CLOSE_LAG_FRAMES > 0
+typedef gs_fit_memo fit_memo;  /* a pending close keeps its memo (gs_flight.h) */
+#else
 typedef struct {
     bool valid;
 #ifndef __OPTIMIZE_SIZE__
@@ -534,6 +569,7 @@ typedef struct {
     gs_fit_result r;
 #endif
 } fit_memo;
+#endif
 
 /* gs_fit_robust of ring samples [first, first+count) into f->keep, once per memo */
 static NOINLINE gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, uint32_t count, gs_fit_method method,
@@ -634,12 +670,15 @@ static bool seed_core_width(gs_flight *f, uint32_t apex, uint32_t newest, int64_
     return true;
 }
 
+/* the seed's core half-widths, tried in turn: wider when noise hides the curve */
+static const int32_t seed_half_us[] = {CORE_HALF_US, CORE_HALF_US * 145 / 100, CORE_HALF_US * 19 / 10};
+#define SEED_WIDTHS (sizeof seed_half_us / sizeof seed_half_us[0])
+
 /* Seed a flight at an apex: fit a core around it, wider when noise hides the curve. */
 static bool seed_core(gs_flight *f, uint32_t apex, uint32_t newest)
 {
-    static const int32_t half_us[] = {CORE_HALF_US, CORE_HALF_US * 145 / 100, CORE_HALF_US * 19 / 10};
-    for (unsigned k = 0; k < sizeof half_us / sizeof half_us[0]; k++)
-        if (seed_core_width(f, apex, newest, half_us[k])) return true;
+    for (unsigned k = 0; k < SEED_WIDTHS; k++)
+        if (seed_core_width(f, apex, newest, seed_half_us[k])) return true;
     return false;
 }
 
@@ -966,57 +1005,74 @@ static gs_real rigid_size(const gs_flight *f, uint32_t lo, uint32_t hi, gs_real 
     return median_se(v, n, se_out);
 }
 
+#define WALK_FREE 16  /* samples a step may walk toward the take-off and still refit at an alarm */
+#define CLOSE_LAG_US 60000  /* a close spread over frames ends this soon after its landing's frame */
+
 /* Grow the flight backwards in time from the core with the same CUSUM test.
  * Every sample but gross outliers enters the running fit (so a biased early
  * fit corrects itself); the flight's edge is the last sample after which the
- * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end. */
-static uint32_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
+ * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end
+ * (GS_CLOSE_GROWN). all: walk to the end; else stop after an alarm's refit, or before
+ * one once the walk took WALK_FREE samples. True when it ran a refit or stopped for one. */
+static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, bool *spent)
 {
-    uint32_t alarm = GS_NO_IDX;
-    uint32_t outl = 0;
-    gs_real S = GS_R(0.0);
     uint32_t floor_idx = history_floor(f);
-    int64_t t_prev = t_at(f, f->fl_first);
     int64_t t_seed = t_at(f, f->seed_idx);
-    uint32_t clean = f->fl_first;
-    uint32_t i = f->fl_first;
-    while (i > floor_idx) {
-        i--;
-        gs_sample_full s_b;
-        const gs_sample_full *s = at(f, i, &s_b);
-        if (!s) break;
-        if (!usable(s)) continue;
-        if (span_over(t_prev, s->t_us, f->max_gap_us)) break;
-        if (span_over(t_seed, s->t_us, f->max_flight_us)) break;
-        t_prev = s->t_us;
-        gs_real z;
-        if (!test_sample(f, r, s, &z)) {
-            if (++outl > 2) break;
-            continue;
-        }
-        outl = 0;
-        S = cusum_step(S, z);
-        if (S > CUSUM_H && z > CUSUM_K) {
-            if (alarm_is_false(f, m, i, f->fl_last, i, -1)) {
-                clean = i;
-                f->fl_first = i;
-                S = GS_R(0.0);
-                gs_fit_solve(&f->fit, r);
+    uint32_t walked = 0;
+#if GS_CLOSE_LAG_FRAMES > 0
+    bool due = c->alarm_due;  /* the walk stopped at an alarm: its refit first */
+    c->alarm_due = false;
+#else
+    bool due = false;
+#endif
+    for (;;) {
+        if (!due) {
+            if (c->walk_i <= floor_idx) break;
+            uint32_t i = --c->walk_i;
+            gs_sample_full s_b;
+            const gs_sample_full *s = at(f, i, &s_b);
+            if (!s) break;
+            if (!usable(s)) continue;
+            if (span_over(c->t_prev_us, s->t_us, f->max_gap_us)) break;
+            if (span_over(t_seed, s->t_us, f->max_flight_us)) break;
+            c->t_prev_us = s->t_us;
+            walked++;
+            gs_real z;
+            if (!test_sample(f, &c->r, s, &z)) {
+                if (++c->outliers > 2) break;
                 continue;
             }
-            alarm = i;
-            break;
+            c->outliers = 0;
+            c->cusum = cusum_step(c->cusum, z);
+            if (!(c->cusum > CUSUM_H && z > CUSUM_K)) {
+                fit_add(f, s);
+                gs_fit_solve(&f->fit, &c->r);
+                if (c->cusum == GS_R(0.0)) c->clean = i;
+                continue;
+            }
+#if GS_CLOSE_LAG_FRAMES > 0
+            if (!all && walked > WALK_FREE) {  /* its refit in the next step */
+                c->alarm_due = true;
+                *spent = true;
+                return GS_CLOSE_GROW;
+            }
+#endif
         }
-        fit_add(f, s);
-        gs_fit_solve(&f->fit, r);
-        if (S == GS_R(0.0)) clean = i;
+        due = false;
+        /* contact at walk_i, or a refit through it shows a false alarm */
+        uint32_t i = c->walk_i;
+        *spent = true;
+        if (!alarm_is_false(f, m, i, f->fl_last, i, -1)) {
+            c->left_alarm = i;
+            return GS_CLOSE_GROWN;
+        }
+        c->clean = i;
+        f->fl_first = i;
+        c->cusum = GS_R(0.0);
+        gs_fit_solve(&f->fit, &c->r);
+        if (!all) return GS_CLOSE_GROW;
     }
-    if (clean != f->fl_first || alarm != GS_NO_IDX) {
-        f->fl_first = clean;
-        gs_fit_result rr;  /* r changes only when the refit succeeds */
-        if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, r);
-    }
-    return alarm;
+    return c->clean != f->fl_first ? GS_CLOSE_GROWN : GS_CLOSE_BOUNDS;
 }
 
 /* Contact samples past the flight edge (side -1: before take-off, +1: after
@@ -1025,10 +1081,9 @@ static uint32_t grow_left(gs_flight *f, fit_memo *m, gs_fit_result *r)
  * (after an impact the body soon stops following it). Returns how many;
  * *outer = the outermost, *first = the nearest. */
 static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t edge, int side,
-                            uint32_t *outer, uint32_t *first)
+                            uint32_t head, uint32_t *outer, uint32_t *first)
 {
     uint32_t floor_idx = history_floor(f);
-    uint32_t head = idx_of(f, gs_ring_head(f->ring));
     uint32_t n = 0;
     gs_real z_prev = -INFINITY;
     uint32_t i = edge;
@@ -1052,14 +1107,15 @@ static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r,
 /* The boundary time on one side (GS_T_NONE: unknown) from the flight's edge and the contact
  * samples past it (those end where contact was detected, alarm: further out the ground
  * phase is no longer a constant force); *outer = the outermost contact sample. */
-static int64_t boundary_time(const gs_flight *f, const gs_fit_result *r, int side, bool alarm,
+static int64_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool alarm,
                             uint32_t edge, uint32_t other_edge, bool refine, gs_real pen,
                             uint32_t *outer)
 {
+    const gs_fit_result *r = &c->r;
     uint32_t first = edge;  /* the first contact sample */
     *outer = edge;
     if (!refine) return GS_T_NONE;
-    uint32_t n = alarm ? contact_run(f, r, edge, side, outer, &first) : 0;
+    uint32_t n = alarm ? contact_run(f, r, edge, side, c->head, outer, &first) : 0;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
     if (n >= 2)
@@ -1115,80 +1171,119 @@ static NOINLINE void restart_levels(gs_flight *f, uint32_t i)
     f->n_hist = 0;
 }
 
-/* Close the open candidate. right_alarm: the sample at which contact was
- * detected after the flight (GS_NO_IDX when it ended otherwise). */
-static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t right_alarm, bool truncated)
+/* The close is over: the next flight may start right after this landing (land_idx: the
+ * first sample after the flight, GS_NO_IDX unknown), its take-off side must see the
+ * contact samples that follow it */
+static void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
 {
-    uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
-    gs_fit_result r;
-    if (gs_fit_solve(&f->fit, &r) != GS_OK) goto done;
-    uint32_t left_alarm = grow_left(f, m, &r);
+    f->quiet_from = land_idx < c->newest ? land_idx : c->newest;  /* (GS_NO_IDX is above every index) */
+    restart_levels(f, c->newest);  /* next seeds start after the landing */
+}
 
+/* GS_CLOSE_START: the flight's fit as grown so far, and the take-off side's walk from its first sample */
+static uint8_t close_start(gs_flight *f, gs_close *c)
+{
+    if (gs_fit_solve(&f->fit, &c->r) != GS_OK) {
+        close_done(f, c, GS_NO_IDX);
+        return GS_CLOSE_NONE;
+    }
+    c->walk_i = c->clean = f->fl_first;
+    c->outliers = 0;
+    c->cusum = GS_R(0.0);
+    c->t_prev_us = t_at(f, f->fl_first);
+    c->left_alarm = GS_NO_IDX;
+#if GS_CLOSE_LAG_FRAMES > 0
+    c->alarm_due = false;
+#endif
+    return GS_CLOSE_GROW;
+}
+
+/* GS_CLOSE_BOUNDS: the take-off and landing times (the feet's, else the COM's contact model)
+ * and the samples of the final fit */
+static uint8_t close_bounds(gs_flight *f, gs_close *c)
+{
+    const gs_fit_result *r = &c->r;
     /* boundary refinement on the up direction of the flight's own acceleration */
     gs_real save_ux = f->up_x, save_uy = f->up_y;
-    if (finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
-        f->up_x = -r.ax_px_s2 / r.a_px_s2;
-        f->up_y = -r.ay_px_s2 / r.a_px_s2;
+    bool falls = finite_r(r->a_px_s2) && r->a_px_s2 > GS_R(0.0);
+    if (falls) {
+        f->up_x = -r->ax_px_s2 / r->a_px_s2;
+        f->up_y = -r->ay_px_s2 / r->a_px_s2;
     }
     uint32_t L = f->fl_first, R = f->fl_last;
     /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
-    float floor_off = NAN, floor_on = NAN, floor_before = NAN;
-    int64_t F0 = GS_T_NONE, F1 = GS_T_NONE;
-    bool feet_contradict = false;  /* the feet, in view, show no flight there */
-    bool fell = false;             /* ... or a fall to a lower floor */
-    if (GS_WITH_POSE && f->feet_on && finite_r(r.a_px_s2) && r.a_px_s2 > GS_R(0.0)) {
+    if (GS_WITH_POSE) {  /* (read only where a layout shows feet) */
+        c->floor_off_px = c->floor_on_px = c->floor_before_px = NAN;
+        c->F0_us = c->F1_us = GS_T_NONE;
+        c->feet_contradict = false;  /* the feet, in view, show no flight there */
+        c->fell = false;             /* ... or a fall to a lower floor */
+    }
+    if (GS_WITH_POSE && f->feet_on && falls) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
-        int64_t apex_us = fit_apex_us(&r);
+        int64_t apex_us = fit_apex_us(r);
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
 
-            F0 = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &floor_off);
+            c->F0_us = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &c->floor_off_px);
             int64_t from = c1 - FEET_BEFORE_COM_US > apex_us ? c1 - FEET_BEFORE_COM_US : apex_us;
-            F1 = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &floor_on, &floor_before);
+            c->F1_us = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &c->floor_on_px, &c->floor_before_px);
         }
+        int64_t F0 = c->F0_us, F1 = c->F1_us;
         DBG("feet: com %lld..%lld apex %lld -> F0 %lld F1 %lld floors %.1f %.1f before %.1f\n", (long long)c0,
-            (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, floor_off, floor_on, floor_before);
-        if (F0 != GS_T_NONE && F1 != GS_T_NONE && F1 <= F0) F0 = F1 = GS_T_NONE;
+            (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, c->floor_off_px, c->floor_on_px,
+            c->floor_before_px);
+        if (F0 != GS_T_NONE && F1 != GS_T_NONE && F1 <= F0) c->F0_us = c->F1_us = F0 = F1 = GS_T_NONE;
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
          * rested, as in quick hops, say nothing: the COM times the flight) */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
-            feet_contradict = gs_feet_resting_at(&f->feet, apex_us) ||
+            c->feet_contradict = gs_feet_resting_at(&f->feet, apex_us) ||
                               (F0 != GS_T_NONE && F1 == GS_T_NONE && gs_feet_airborne(&f->feet));
         /* a fall: the feet went well below the floor they left (a box): after a clean take-off
          * below its floor, else below the floor they had rested on */
-        float d_px = f->feet.delta_rel * (float)gate_size(f, L);
+        float size_px = (float)gate_size(f, L);
+        float d_px = f->feet.delta_rel * size_px;
         /* (toes stop where they land: after it a squat's or a moving camera's frames are no
          * floor; an ankle's recrossing is above the floor it then comes down to) */
-        float low_px = F1 != GS_T_NONE && f->feet.stop_touch ? floor_on : gs_feet_low_px(&f->feet);
-        fell = F0 != GS_T_NONE ? low_px < floor_off - d_px - FALL_FLOOR_REL * (float)gate_size(f, L)
+        float low_px = F1 != GS_T_NONE && f->feet.stop_touch ? c->floor_on_px : gs_feet_low_px(&f->feet);
+        c->fell = F0 != GS_T_NONE ? low_px < c->floor_off_px - d_px - FALL_FLOOR_REL * size_px
                                : gs_feet_sank_since(&f->feet, c0);
     }
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
-    bool refine = held(f, L) && !(F0 != GS_T_NONE && F1 != GS_T_NONE);  /* a body's are its feet's where seen */
-    gs_real sig = fit_sigma(f, &r);
+    bool feet = GS_WITH_POSE && c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    if (GS_WITH_POSE) c->feet = feet;
+    bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
+    gs_real sig = fit_sigma(f, r);
     gs_real pen = DROP_PENALTY * sig * sig;
     uint32_t lo, hi;  /* the outermost contact samples */
-    int64_t T0 = boundary_time(f, &r, -1, left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
-    int64_t T1 = boundary_time(f, &r, +1, right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
+    int64_t T0 = c->T0_us = boundary_time(f, c, -1, c->left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
+    int64_t T1 = c->T1_us = boundary_time(f, c, +1, c->right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
-        (long long)T0, (long long)T1, r.a_px_s2);
+        (long long)T0, (long long)T1, r->a_px_s2);
     /* with the feet's times: the flight and the nearly free frames beside it (the push-off's
      * last tens of ms, when the ground already bears less than the weight; the first of the
      * landing) as far as the parabola explains them */
     int64_t W0 = T0, W1 = T1;
-    if (F0 != GS_T_NONE && F1 != GS_T_NONE) {
-        W0 = F0 - FEET_FREE_EDGE_US;
-        W1 = F1 + FEET_FREE_EDGE_US;
+    if (feet) {
+        W0 = c->F0_us - FEET_FREE_EDGE_US;
+        W1 = c->F1_us + FEET_FREE_EDGE_US;
     }
-    uint32_t in_lo = trim_edge(f, lo, hi, W0, -1, L);
-    uint32_t in_hi = trim_edge(f, hi, in_lo, W1, +1, R);
+    c->in_lo = trim_edge(f, lo, hi, W0, -1, L);
+    c->in_hi = trim_edge(f, hi, c->in_lo, W1, +1, R);
     f->up_x = save_ux;
     f->up_y = save_uy;
+    return GS_CLOSE_FINAL;
+}
 
+/* GS_CLOSE_FINAL: the final robust fit over the flight's samples, the judgement and the event */
+static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
+{
+    uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
+    int64_t T0 = c->T0_us, T1 = c->T1_us;
+    uint32_t in_lo = c->in_lo, in_hi = c->in_hi;
     gs_sample_full sf_b, sl_b;
     const gs_sample_full *sf = at(f, in_lo, &sf_b), *sl = at(f, in_hi, &sl_b);
     if (!sf || !sl || in_hi < in_lo) goto done;
@@ -1220,9 +1315,10 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t
     if (T0 == GS_T_NONE) T0 = sf->t_us - half_dt;
     if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
-    bool feet = F0 != GS_T_NONE && F1 != GS_T_NONE;
+    bool feet = GS_WITH_POSE && c->feet;  /* (no layout with feet: their code folds away) */
+    int64_t F1 = GS_WITH_POSE ? c->F1_us : GS_T_NONE;
     if (feet) {  /* (one end from the feet and the other from the COM would mix two definitions) */
-        T0 = F0;
+        T0 = c->F0_us;
         T1 = F1;
     }
 
@@ -1251,10 +1347,7 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t
         j->rms_px = fr.rms_px;
         gs_real q = g / fr.a_px_s2, height = NAN;
         j->q_m_per_px = q;
-        /* apex: where the velocity along gravity is zero */
-        gs_real gx = fr.ax_px_s2 / fr.a_px_s2, gy = fr.ay_px_s2 / fr.a_px_s2;
-        gs_real v_down = fr.vx_px_s * gx + fr.vy_px_s * gy;
-        gs_real apex_s = -v_down / fr.a_px_s2;  /* after the fit's t0 */
+        gs_real apex_s = fit_apex_s(&fr);
         j->t_apex_us = gs_time_add_s(fr.t0_us, apex_s);
         gs_real rise_t = gs_time_span_s(fr.t0_us, T0) + apex_s;
         j->jump_height_m = g * j->flight_time_s * j->flight_time_s / GS_R(8.0);
@@ -1270,7 +1363,7 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t
         if (!IS_RIGID(f) && !feet) j->warnings |= GS_WARN_COM_TIMED;
         /* the stature only where the body stood at the flight's place (its feet on the same floor row) */
         if (feet && finite_r(size) && f->feet.epoch == f->stand_floor_epoch && finite_r(f->stand_floor_px) &&
-            finite_r(floor_off) && GS_FABSR((gs_real)(floor_off - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
+            finite_r(c->floor_off_px) && GS_FABSR((gs_real)(c->floor_off_px - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
             j->warnings |= GS_WARN_DEPTH_CHANGED;
             size = size_se = NAN;
             j->size_px = NAN;
@@ -1292,9 +1385,9 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
 
-        if (fell || (F1 != GS_T_NONE && finite_r(gsize) && floor_on < floor_before - FALL_FLOOR_REL * (float)gsize))
+        if ((GS_WITH_POSE && c->fell) || (F1 != GS_T_NONE && finite_r(gsize) && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
-        else if (feet_contradict)
+        else if (GS_WITH_POSE && c->feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;
         else if (n_in < f->cfg->min_samples || T1 - T0 < f->min_flight_us)
             j->reason = GS_REJ_FEW_SAMPLES;
@@ -1319,7 +1412,7 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t
 
         if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
-        if (truncated) j->warnings |= GS_WARN_CLIPPED;
+        if (c->truncated) j->warnings |= GS_WARN_CLIPPED;
         if (f->n_flights > 0 && finite_r(f->last_g_dir_deg) &&
             GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
             j->warnings |= GS_WARN_GRAVITY_TILT;
@@ -1341,16 +1434,238 @@ static void close_candidate(gs_flight *f, fit_memo *m, uint32_t newest, uint32_t
     emit(f, &ev);
 
 done:
-    /* the next flight may start right after this landing: its take-off side must
-     * see the contact samples that follow it */
-    f->quiet_from = newest;
-    if (land_idx != GS_NO_IDX && land_idx < newest) f->quiet_from = land_idx;
-    restart_levels(f, newest);  /* next seeds start after the landing */
+    close_done(f, c, land_idx);
+    return GS_CLOSE_NONE;
+}
+
+static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t);
+
+/* Take the close's steps: all of them (all), else until one has run a robust fit or the
+ * boundary search. */
+static void close_run(gs_flight *f, gs_close *c, bool all)
+{
+#if GS_CLOSE_LAG_FRAMES > 0
+    fit_memo *m = &c->memo;
+#else
+    fit_memo memo = {0}, *m = &memo;  /* (every step in this call) */
+#endif
+    bool spent = false;
+    uint8_t stage = c->stage;
+    while (stage != GS_CLOSE_NONE && (all || !spent)) {
+        switch (stage) {
+        case GS_CLOSE_REFIT: {  /* the running fit may hold samples past the edge: rebuild it over the flight */
+            gs_fit_result r;
+            refit_range(f, m, f->fl_first, f->fl_last, &r);
+            stage = GS_CLOSE_START;
+            spent = true;
+            break;
+        }
+        case GS_CLOSE_START: stage = close_start(f, c); break;
+        case GS_CLOSE_GROW: stage = grow_left_step(f, c, m, all, &spent); break;
+        case GS_CLOSE_GROWN: {
+            f->fl_first = c->clean;
+            gs_fit_result rr;  /* r changes only when the refit succeeds */
+            if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, &c->r);
+            stage = GS_CLOSE_BOUNDS;
+            spent = true;
+            break;
+        }
+        case GS_CLOSE_BOUNDS: stage = close_bounds(f, c); spent = true; break;
+#if GS_CLOSE_LAG_FRAMES > 0
+        case GS_CLOSE_SEED:
+            spent = true;
+            if (seed_core_width(f, c->apex, c->newest, seed_half_us[c->width])) {
+                c->stage = GS_CLOSE_NONE;
+                seed_found(f, c->newest, t_at(f, c->apex));  /* (its landing may begin a close) */
+                stage = c->stage;
+            } else if (++c->width == SEED_WIDTHS) {
+                stage = GS_CLOSE_NONE;
+            }
+            break;
+#endif
+        default: stage = close_final(f, c, m); break;
+        }
+    }
+    c->stage = stage;
+}
+
+/* Begin closing the open candidate. right_alarm: the sample at which contact was
+ * detected after the flight (GS_NO_IDX when it ended otherwise); refit: rebuild the
+ * running fit over the flight first. */
+static void close_begin(gs_flight *f, gs_close *c, uint32_t newest, uint32_t right_alarm, bool truncated, bool refit)
+{
+    c->newest = newest;
+    c->right_alarm = right_alarm;
+    c->truncated = truncated;
+    c->head = idx_of(f, gs_ring_head(f->ring));
+    c->stage = refit ? GS_CLOSE_REFIT : GS_CLOSE_START;
+#if GS_CLOSE_LAG_FRAMES > 0
+    c->memo.valid = false;
+#endif
+}
+
+#if GS_CLOSE_LAG_FRAMES > 0
+/* The largest turn (cos, sin) a close can give the image's up: it sets it from an accepted
+ * flight, whose gravity lies within plausible_fall's cone (80 degrees at most) and, once an up
+ * is known, within gravity_agrees's limit at the largest accepted SE; blended 0.3 once
+ * flights set it. (A little wider for rounding.) */
+static void up_turn_max(const gs_flight *f, gs_real *cos_out, gs_real *sin_out)
+{
+    gs_real cap = GS_R(80.0) * GS_PI / GS_R(180.0);
+    gs_real lim = GRAV_DIR_SE_K * (gs_real)f->cfg->max_a_se_rel + GRAV_DIR_MIN_DEG * GS_PI / GS_R(180.0);
+    gs_real th = (f->up_from_flight || f->up_n > 0) && lim < cap ? lim : cap;
+    gs_real c = (gs_real)GS_COS(th + GS_R(1e-3)), s = (gs_real)GS_SIN(th + GS_R(1e-3));
+    if (f->up_from_flight) {
+        gs_real bx = GS_R(0.7) + GS_R(0.3) * c, by = GS_R(0.3) * s, n = GS_SQRT(bx * bx + by * by);
+        c = bx / n;
+        s = by / n;
+    }
+    *cos_out = c;
+    *sin_out = s;
+}
+
+/* Could the standing tracker take waiting sample i once it is examined (gs_flight_stand_at
+ * answers for the newest frame while it waits)? False only where it provably cannot: not
+ * examined, one of the first two after the close (their median of three is not yet
+ * formed), not upright, or inside STAND_SETTLE_US of a frame that ended any stillness. The
+ * third and fourth (both examined on the ground: no flight is seeded before) end it when
+ * they move faster than a standing body along any up the close may set; later ones could
+ * follow another close. Checked in order: tracks the frame interval as examine will. */
+static bool may_stand(gs_flight *f, gs_close *c, uint32_t i)
+{
+    gs_sample_full s_b;
+    const gs_sample_full *s = at(f, i, &s_b);
+    if (!s || !(s->w > 0.0f)) return false;
+    int64_t t_prev = c->t_last_us;
+    c->t_last_us = s->t_us;
+    if (!usable(s)) return false;
+    uint32_t dt_q4 = f->dt_med_q4;
+    f->dt_med_q4 = c->dt_q4;
+    if (t_prev != GS_T_NONE) {
+        track_frame_dt(f, s->t_us - t_prev);
+        if (s->t_us - t_prev > f->max_gap_us) c->n_ground = 0;  /* the levels restart */
+    }
+    c->dt_q4 = f->dt_med_q4;
+    uint32_t k = frame_steps(f, STAND_LAG_US, 1);
+    f->dt_med_q4 = dt_q4;
+    if (++c->n_ground < 3 || IS_RIGID(f) || !size_ok(s->size_px)) return false;
+    gs_real thr = STAND_SPEED_REL * (gs_real)s->size_px;
+    gs_sample_full b_b;
+    const gs_sample_full *b = k >= 1 && i >= c->low + k ? usable_at(f, i - k, &b_b) : NULL;
+    if (c->n_ground <= 4 && b && s->t_us > b->t_us) {
+        gs_real cs, sn;
+        up_turn_max(f, &cs, &sn);
+        gs_real dx = (gs_real)s->x_px - (gs_real)b->x_px, dy = (gs_real)s->y_px - (gs_real)b->y_px;
+        gs_real along = GS_FABSR(dx * f->up_x + dy * f->up_y), across = GS_FABSR(dy * f->up_x - dx * f->up_y);
+        if ((along * cs - across * sn) / gs_time_span_s(s->t_us, b->t_us) > thr * GS_R(1.001)) {
+            c->still_after_us = s->t_us;
+            return false;
+        }
+    }
+    if (!(s->upright >= STAND_UPRIGHT)) return false;
+    return c->still_after_us == GS_T_NONE || s->t_us - c->still_after_us >= STAND_SETTLE_US;
+}
+
+/* Must the pending close finish in this frame? It adds at most CLOSE_LAG_US to its event's
+ * latency (a visit's absence, at least 0.5 s, cannot end meanwhile); the samples it reads
+ * must stay in the ring (the next push must not overwrite the oldest), and no frame it
+ * holds back may be one the standing tracker takes (may_stand). Trace events come in the
+ * stream's order. */
+static bool close_due(gs_flight *f)
+{
+    gs_close *c = &f->close;
+    uint32_t head = idx_of(f, gs_ring_head(f->ring));
+    int64_t t_new_us = f->ring->t_last_us;
+    if (f->trace || head - c->head >= GS_CLOSE_LAG_FRAMES || head + 1u - c->low >= f->ring->capacity ||
+        (t_new_us != GS_T_NONE && t_new_us - c->t_end_us >= CLOSE_LAG_US))
+        return true;
+    while (c->checked < head)
+        if (may_stand(f, c, c->checked++)) return true;
+    return false;
+}
+
+/* The held feet of the frames up to t_us into the feet's tracker (the frame's sample is
+ * examined next; no job pends) */
+static void feet_release(gs_flight *f, int64_t t_us)
+{
+    uint32_t n = 0;
+    while (n < f->feet_held_n && f->feet_held[n].t_us <= t_us) {
+        const gs_feet_frame *h = &f->feet_held[n++];
+        gs_flight_feet(f, h->t_us, h->x_px, h->y_px, h->size_px);  /* (no job pends: pushed) */
+    }
+    if (n == 0) return;
+    f->feet_held_n -= n;
+    memmove(f->feet_held, f->feet_held + n, f->feet_held_n * sizeof f->feet_held[0]);
+}
+#endif
+
+/* Close the open candidate at once */
+static void close_now(gs_flight *f, uint32_t newest, uint32_t right_alarm, bool truncated, bool refit)
+{
+#if GS_CLOSE_LAG_FRAMES > 0
+    gs_close *c = &f->close;
+#else
+    gs_close cl, *c = &cl;
+#endif
+    close_begin(f, c, newest, right_alarm, truncated, refit);
+    close_run(f, c, true);
 }
 
 /* ---- the per-sample state machine ------------------------------------------ */
 
 static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s);
+
+/* The seed holds: airborne from its apex; samples after the core that arrived meanwhile
+ * (through newest) are tested in order */
+static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t)
+{
+    set_state(f, GS_FS_AIRBORNE, apex_t);
+    for (uint32_t i = f->fl_last + 1; i <= newest && f->state == GS_FS_AIRBORNE; i++) {
+        gs_sample_full p_b;
+        const gs_sample_full *p = usable_at(f, i, &p_b);
+        if (p) airborne_sample(f, i, p);
+    }
+}
+
+#if GS_CLOSE_LAG_FRAMES > 0
+/* A job that waits for the next frames (a close or a seed, its newest sample at t_us): no
+ * sample is examined meanwhile, n_ground: usable samples since the levels restarted (see
+ * may_stand), low: the oldest sample it may read */
+static void job_wait(gs_flight *f, gs_close *c, int64_t t_us, uint32_t n_ground, uint32_t low)
+{
+    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
+    c->head = idx_of(f, gs_ring_head(f->ring));
+    c->t_end_us = t_us;
+    c->low = low > oldest ? low : oldest;
+    c->checked = f->next;
+    c->n_ground = n_ground;
+    c->dt_q4 = f->dt_med_q4;
+    c->t_last_us = f->last_t_us;
+    /* a stillness goes on from when it began, or begins after now */
+    c->still_after_us = f->still_since_us != GS_T_NONE ? f->still_since_us : t_us;
+}
+
+/* Seed a flight at an apex (ground_sample): the two narrower core widths now, the widest
+ * in the next frame (GS_CLOSE_SEED; at once when that frame could be a standing one, as it is
+ * when the "apex" was a standing body's noise) */
+#define SEED_WIDTHS_NOW 2
+static void seed_begin(gs_flight *f, uint32_t apex, uint32_t newest, int64_t apex_t, int64_t t_us)
+{
+    for (unsigned k = 0; k < SEED_WIDTHS_NOW; k++)
+        if (seed_core_width(f, apex, newest, seed_half_us[k])) {
+            seed_found(f, newest, apex_t);
+            return;
+        }
+    gs_close *c = &f->close;
+    c->stage = GS_CLOSE_SEED;
+    c->apex = apex;
+    c->width = SEED_WIDTHS_NOW;
+    c->newest = newest;
+    /* (the levels run on, and a flight may be seeded next: no sample is spared the test) */
+    job_wait(f, c, t_us, 4u, history_floor(f));
+    if (close_due(f)) close_run(f, c, true);
+}
+#endif
 
 /* |du/dt| against the sample about lag_us back (frame jitter is not motion); NaN unknown */
 static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full *s, gs_real u, int64_t lag_us)
@@ -1434,6 +1749,9 @@ gs_real gs_flight_stand_at(const gs_flight *f, int64_t t_us)
 void gs_flight_forget_body(gs_flight *f)
 {
     if (!f) return;
+#if GS_CLOSE_LAG_FRAMES > 0
+    close_finish(f);  /* the close judges with the body it measured */
+#endif
     f->stand_n = f->stand_next = 0;
     f->loose_n = f->loose_next = 0;
     f->stand_last_us = GS_T_NONE;
@@ -1522,15 +1840,13 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
     uint32_t apex = f->peak_idx;
     int64_t apex_t = f->peak_t_us;
     f->peak_u = -INFINITY;
-    if (seed_core(f, apex, idx)) {
-        set_state(f, GS_FS_AIRBORNE, apex_t);
-        /* samples after the core that arrived meanwhile are tested in order */
-        for (uint32_t i = f->fl_last + 1; i <= idx && f->state == GS_FS_AIRBORNE; i++) {
-            gs_sample_full p_b;
-            const gs_sample_full *p = usable_at(f, i, &p_b);
-            if (p) airborne_sample(f, i, p);
-        }
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (!f->trace) {
+        seed_begin(f, apex, idx, apex_t, s->t_us);
+        return;
     }
+#endif
+    if (seed_core(f, apex, idx)) seed_found(f, idx, apex_t);
 }
 
 static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_full *s)
@@ -1544,11 +1860,20 @@ static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_ful
         return;
     }
     f->feet_wait_us = GS_T_NONE;
-    /* the running fit may hold samples past the edge: rebuild it over the flight */
-    gs_fit_result r;
-    fit_memo m = {0};
-    refit_range(f, &m, f->fl_first, f->fl_last, &r);
-    close_candidate(f, &m, idx, alarm, false);
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (!f->trace) {
+        gs_close *c = &f->close;
+        close_begin(f, c, idx, alarm, false, true);
+        uint32_t floor_idx = history_floor(f);
+        job_wait(f, c, s->t_us, 0u, f->fl_first < floor_idx ? f->fl_first : floor_idx);
+        if (!close_due(f)) {  /* its steps in the next frames */
+            set_state(f, GS_FS_GROUND, s->t_us);
+            return;
+        }
+        c->stage = GS_CLOSE_NONE;
+    }
+#endif
+    close_now(f, idx, alarm, false, true);
     set_state(f, GS_FS_GROUND, s->t_us);
 }
 
@@ -1619,7 +1944,14 @@ static NOINLINE void rebase(gs_flight *f)
         offsetof(gs_flight, next), offsetof(gs_flight, quiet_from), offsetof(gs_flight, last_idx),
         offsetof(gs_flight, i_hist[0]), offsetof(gs_flight, i_hist[1]), offsetof(gs_flight, i_hist[2]),
         offsetof(gs_flight, peak_idx), offsetof(gs_flight, fl_first), offsetof(gs_flight, fl_last),
-        offsetof(gs_flight, seed_idx), offsetof(gs_flight, wait_alarm)};
+        offsetof(gs_flight, seed_idx), offsetof(gs_flight, wait_alarm),
+#if GS_CLOSE_LAG_FRAMES > 0
+        offsetof(gs_flight, close.newest), offsetof(gs_flight, close.head), offsetof(gs_flight, close.low),
+        offsetof(gs_flight, close.right_alarm), offsetof(gs_flight, close.left_alarm),
+        offsetof(gs_flight, close.walk_i), offsetof(gs_flight, close.clean),
+        offsetof(gs_flight, close.in_lo), offsetof(gs_flight, close.in_hi), offsetof(gs_flight, close.apex),
+#endif
+    };
     uint64_t head = gs_ring_head(f->ring);
     if (head - f->base <= 2u * (uint64_t)GS_FLIGHT_IDX_KEEP) return;
     uint32_t by = idx_of(f, head - GS_FLIGHT_IDX_KEEP);
@@ -1630,9 +1962,9 @@ static NOINLINE void rebase(gs_flight *f)
     }
 }
 
-void gs_flight_update(gs_flight *f)
+/* Examine the samples pushed since (each after its frame's feet) until a close is pending */
+static void examine(gs_flight *f)
 {
-    rebase(f);
     uint32_t head = idx_of(f, gs_ring_head(f->ring));
     uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
     if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */
@@ -1640,6 +1972,9 @@ void gs_flight_update(gs_flight *f)
         uint32_t idx = f->next++;
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, idx, &s_b);
+#if GS_CLOSE_LAG_FRAMES > 0
+        if (s && f->feet_held_n > 0) feet_release(f, s->t_us);
+#endif
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
         bool present = s && s->w > 0.0f;
@@ -1649,10 +1984,7 @@ void gs_flight_update(gs_flight *f)
             int64_t dt = s->t_us - f->last_t_us;
             track_frame_dt(f, dt);
             if (dt > f->max_gap_us) {
-                if (f->state == GS_FS_AIRBORNE) {
-                    fit_memo m = {0};
-                    close_candidate(f, &m, f->last_idx, GS_NO_IDX, true);
-                }
+                if (f->state == GS_FS_AIRBORNE) close_now(f, f->last_idx, GS_NO_IDX, true, false);
                 restart_levels(f, GS_NO_IDX);  /* never held: from nothing */
                 set_state(f, GS_FS_GROUND, s->t_us);
             }
@@ -1662,8 +1994,38 @@ void gs_flight_update(gs_flight *f)
         if (f->state == GS_FS_IDLE) set_state(f, GS_FS_GROUND, s->t_us);
         if (f->state == GS_FS_AIRBORNE) airborne_sample(f, idx, s);
         else ground_sample(f, idx, s);
+#if GS_CLOSE_LAG_FRAMES > 0
+        if (f->close.stage != GS_CLOSE_NONE) return;  /* the rest waits for it */
+#endif
+    }
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (f->feet_held_n > 0) feet_release(f, INT64_MAX);
+#endif
+}
+
+#if GS_CLOSE_LAG_FRAMES > 0
+/* Finish a pending close now, and any a later sample begins, examining what waited */
+static void close_finish(gs_flight *f)
+{
+    while (f->close.stage != GS_CLOSE_NONE) {
+        close_run(f, &f->close, true);
+        examine(f);
     }
 }
+#endif
+
+void gs_flight_update(gs_flight *f)
+{
+    rebase(f);
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (f->close.stage != GS_CLOSE_NONE) {
+        close_run(f, &f->close, close_due(f));
+        if (f->close.stage != GS_CLOSE_NONE) return;
+    }
+#endif
+    examine(f);
+}
+
 
 /* the stream ends or pauses: close an open candidate (one waiting for its feet with its alarm) */
 static void end_flight(gs_flight *f)
@@ -1672,19 +2034,24 @@ static void end_flight(gs_flight *f)
     if (f->state != GS_FS_AIRBORNE) return;
     bool waited = f->feet_wait_us != GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
-    fit_memo m = {0};
-    close_candidate(f, &m, f->last_idx, waited ? f->wait_alarm : GS_NO_IDX, !waited);
+    close_now(f, f->last_idx, waited ? f->wait_alarm : GS_NO_IDX, !waited, false);
     set_state(f, GS_FS_GROUND, f->last_t_us);
 }
 
 void gs_flight_break(gs_flight *f)
 {
     gs_flight_update(f);
+#if GS_CLOSE_LAG_FRAMES > 0
+    close_finish(f);
+#endif
     end_flight(f);  /* what the next sample would do on seeing the gap, while the ring still holds the flight */
 }
 
 void gs_flight_finish(gs_flight *f)
 {
     gs_flight_update(f);
+#if GS_CLOSE_LAG_FRAMES > 0
+    close_finish(f);
+#endif
     end_flight(f);
 }
