@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "ball_outline.hpp"
 #include "ballistic.hpp"
 
 namespace gs {
@@ -21,6 +22,8 @@ namespace {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 const double kAlphaFloor = 0.12;  // alpha below this is background noise, shadow or halo
+const double kRoundMax = 1.06;     // an outline longer than this over its width is stretched by the smear
+const double kMatteMassTol = 0.1;  // a matte whose total is off its outline's area by more is biased by shading
 
 // ---------------------------------------------------------------- config ---
 
@@ -187,6 +190,8 @@ struct Meas {
     bool shadow_color = false;      // darker than the background in its own colour (a shadow, or a grey ball)
     cv::Vec3f color;                // mean colour of the ball's core pixels
     double contrast = 0.0;          // |C - B|
+    bool size_ok = true;            // false: a ball of the background's chromaticity whose outline could not be read
+    bool outline = false;           // the moments are the outline's sharp disc (no blur, no smear)
 };
 
 // one detection of a track
@@ -545,9 +550,11 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
             }
         }
     };
+    int n_plain = 0, n_unmixed = 0;
     auto compute_alpha = [&](const cv::Vec3f &col) {
         const double cc = col.dot(col);
         std::vector<float> core_u;
+        n_plain = n_unmixed = 0;
         for (int y = 0; y < roi.height; y++) {
             const uchar *s = sup.ptr<uchar>(y);
             const cv::Vec3b *ir = I.ptr<cv::Vec3b>(y);
@@ -572,8 +579,10 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
                     ur[x] = (float)u;
                     bw.at<float>(y, x) = (float)beta;
                     if (a > 0.8f) core_u.push_back((float)u);
+                    n_unmixed++;
                 } else {
                     a = (iv - br[x]).dot(v) / vv;
+                    n_plain++;
                 }
                 ar[x] = std::min(1.5f, std::max(-0.5f, a));
             }
@@ -707,6 +716,54 @@ Meas BallDetector::Impl::measure(const cv::Mat &bgr, const Blob &b, const Track 
     r.d_perp = 4.0 * std::sqrt(std::max(0.25 * l2, l2 - psf2));
     r.ratio = std::sqrt(l1 / l2);
     r.at_edge = (box & frame_r) != box;
+    // A ball of the background's chromaticity was read by the plain projection,
+    // which follows its shading (the lit side near the background's level reads
+    // as partial coverage): where the matte does not add up to the area inside the
+    // ball's outline, the outline gives the moments, or none where it cannot be read.
+    if (n_plain > n_unmixed) {
+        const double r_guess = 0.5 * std::max(4.0 * std::sqrt(l2), b.d_minor_s * inv);
+        const double ramp0_px = 2.0 + 2.5 * cfg.psf_sigma_px;
+        BallOutline ol = ball_outline(I, B, cx, cy, r_guess, ramp0_px, cfg.psf_sigma_px);
+        // A smear longer than the edge's ramp window reads the step's level part way
+        // up its ramp and stretches the outline along the motion by about the smear:
+        // read it again with the window reaching over the smear.
+        double smear_px = ol.ok ? 4.0 * (std::sqrt(ellipse_major(ol)) - std::sqrt(ellipse_minor(ol)))
+                                : std::sqrt(12.0 * std::max(0.0, l1 - l2));
+        if (smear_px > 1.0 + 0.05 * 2.0 * r_guess) {
+            BallOutline o2 = ball_outline(I, B, ol.ok ? ol.cx : cx, ol.ok ? ol.cy : cy, r_guess,
+                                          ramp0_px + 1.5 * smear_px, cfg.psf_sigma_px);
+            if (o2.ok || !ol.ok) ol = o2;
+        }
+        const double d_ol = ol.ok ? 4.0 * std::sqrt(ellipse_minor(ol)) : 0.0;
+        // blur and smear keep the matte's total: a matte that adds up to the outline's
+        // disc is not biased by the shading, and its moments stand
+        const double mass = ol.ok ? m0 / (4.0 * CV_PI * std::sqrt(std::max(1e-9, ol.sxx * ol.syy - ol.sxy * ol.sxy)))
+                                  : kNaN;
+        // edges off an ellipse are not the ball's outline alone
+        const bool outline_good = ol.ok && ol.rms_px <= std::max(0.75, 0.03 * d_ol);
+        if (outline_good) {
+            // the outline's centre does not move with the shading
+            r.x = roi.x + ol.cx;
+            r.y = roi.y + ol.cy;
+        }
+        if (std::fabs(mass - 1.0) <= kMatteMassTol) {
+            // the matte's own moments
+        } else if (outline_good && smear_px <= 0.25 * d_ol && ellipse_major(ol) <= kRoundMax * kRoundMax * ellipse_minor(ol)) {
+            // a smear l moves the half level across the motion inward (to sqrt(R^2 - l^2/16)):
+            // below 1 % up to l = D / 4; along it the shading inside the smear's ramp moves
+            // it either way, so the outline stands only where it is round (a sphere's image)
+            r.sxx = ol.sxx;
+            r.syy = ol.syy;
+            r.sxy = ol.sxy;
+            r.outline = true;
+            r.d_perp = d_ol;
+            r.d_area = 4.0 * std::pow(std::max(0.0, ol.sxx * ol.syy - ol.sxy * ol.sxy), 0.25);
+            r.d_kurt = kNaN;
+            r.psf_var = kNaN;
+        } else {
+            r.size_ok = false;
+        }
+    }
     if (sh_n >= 6) {
         double rm = sh_r / sh_n, chroma = sh_chroma / sh_n;
         double vi = sii / sh_n - (si / sh_n) * (si / sh_n), vb = sbb / sh_n - (sb / sh_n) * (sb / sh_n);
@@ -932,6 +989,7 @@ bool BallDetector::Impl::make_obs(const Track &tr, const Pt &p, double vx, doubl
     double conf = 1.0;
     bool good = true, moments = true;
     if (ms.at_edge) { conf *= 0.3; good = false; moments = false; }
+    if (!ms.size_ok) { good = false; moments = false; }
     if (ms.ratio > cfg.max_blur_ratio) good = false;
     conf *= std::max(0.2, 1.0 - 0.3 * std::max(0.0, ms.ratio - 1.2));
     // the area and the width agree for an unoccluded ball (blur keeps both)
@@ -949,6 +1007,7 @@ bool BallDetector::Impl::make_obs(const Track &tr, const Pt &p, double vx, doubl
     o.psf_var_px2 = good ? ms.psf_var : kNaN;
     o.confidence = std::min(1.0, std::max(0.05, conf));
     if (moments) {
+        o.moments_blur_free = ms.outline;
         o.sxx = ms.sxx;
         o.syy = ms.syy;
         o.sxy = ms.sxy;

@@ -66,6 +66,9 @@ struct BallObs {
     // the matte's second moments (px^2, the camera's blur still in), NaN when the
     // detection is no good for a size (at the frame's border, partly hidden, merged)
     double sxx = NAN, syy = NAN, sxy = NAN;
+    // the moments are the ball's outline's (a ball of the background's chromaticity):
+    // its sharp disc, without the camera's blur or the smear
+    bool moments_blur_free = false;
 };
 
 class BallDetector {

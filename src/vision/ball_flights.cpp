@@ -312,24 +312,6 @@ FlightSize BallFlights::measure(const std::vector<BallObs> &pts, const Parabola 
     double gx = amag > 0 ? fit.ax / amag : 0.0, gy = amag > 0 ? fit.ay / amag : 1.0;
     // ---- size
     double dt = frame_dt(pts);
-    std::vector<MomentObs> mo;
-    std::vector<double> widths;
-    for (const BallObs &o : pts) {
-        if (std::isfinite(o.diameter_px)) widths.push_back(o.diameter_px);
-        if (!std::isfinite(o.sxx)) continue;
-        MomentObs m;
-        m.sxx = o.sxx;
-        m.syy = o.syy;
-        m.sxy = o.sxy;
-        m.vx = fit.vx_at(o.t_s);
-        m.vy = fit.vy_at(o.t_s);
-        m.rx = o.x_px - 0.5 * (opt_.frame_w - 1);
-        m.ry = o.y_px - 0.5 * (opt_.frame_h - 1);
-        mo.push_back(m);
-        if (std::getenv("GS_BALL_DEBUG_MOMENTS"))
-            std::fprintf(stderr, "  m t=%.3f v=(%.0f,%.0f) r=(%.0f,%.0f) sxx=%.1f syy=%.1f sxy=%.1f d=%.1f dk=%.2f psf2=%.2f\n", o.t_s, m.vx, m.vy,
-                         m.rx, m.ry, m.sxx, m.syy, m.sxy, o.diameter_px, o.diameter_kurt_px, o.psf_var_px2);
-    }
     // the camera's blur, measured: the 4th moment across the motion tells a
     // Gaussian blur's variance from the disc's (pooled over the clip's detections)
     for (const BallObs &o : pts)
@@ -345,6 +327,27 @@ FlightSize BallFlights::measure(const std::vector<BallObs> &pts, const Parabola 
         v = std::min(std::max(v, opt_.psf_sigma_px * opt_.psf_sigma_px), 25.0);
         psf_sigma = std::sqrt(v);
         psf_unc = std::max(0.25, 2.0 * spread / std::sqrt((double)psf_seen_.size()));
+    }
+    std::vector<MomentObs> mo;
+    std::vector<double> widths;
+    for (const BallObs &o : pts) {
+        if (std::isfinite(o.diameter_px)) widths.push_back(o.diameter_px);
+        if (!std::isfinite(o.sxx)) continue;
+        MomentObs m;
+        // an outline's moments are the sharp disc's: the fit's model adds the blur to them
+        const double blur_px2 = o.moments_blur_free ? psf_sigma * psf_sigma : 0.0;
+        m.sxx = o.sxx + blur_px2;
+        m.syy = o.syy + blur_px2;
+        m.sxy = o.sxy;
+        // ... and the smear: no motion enters their model
+        m.vx = o.moments_blur_free ? 0.0 : fit.vx_at(o.t_s);
+        m.vy = o.moments_blur_free ? 0.0 : fit.vy_at(o.t_s);
+        m.rx = o.x_px - 0.5 * (opt_.frame_w - 1);
+        m.ry = o.y_px - 0.5 * (opt_.frame_h - 1);
+        mo.push_back(m);
+        if (std::getenv("GS_BALL_DEBUG_MOMENTS"))
+            std::fprintf(stderr, "  m t=%.3f v=(%.0f,%.0f) r=(%.0f,%.0f) sxx=%.1f syy=%.1f sxy=%.1f d=%.1f dk=%.2f psf2=%.2f\n", o.t_s, m.vx, m.vy,
+                         m.rx, m.ry, m.sxx, m.syy, m.sxy, o.diameter_px, o.diameter_kurt_px, o.psf_var_px2);
     }
     double fmin = kFocalMinRel * std::max(opt_.frame_w, opt_.frame_h);
     SizeFit sf = fit_size(mo, psf_sigma, 1.05 * dt * dt / 12.0, fmin > 0 ? 1.0 / (fmin * fmin) : 0.0);
