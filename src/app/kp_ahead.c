@@ -6,7 +6,8 @@
 #include <stdbool.h>
 #include <stdlib.h>
 
-#define AHEAD_SLOTS 4
+#define AHEAD_SLOTS 8
+#define AHEAD_REFILL 4 /* a reader that found every slot full waits until this many are free: one wake per 4 batches */
 #define AHEAD_BATCH_FRAMES 256 /* ~100 kB a slot: a few ms of reading, well inside the caches' reach */
 
 typedef struct {
@@ -38,8 +39,9 @@ static void *reader_main(void *arg)
     kp_ahead *q = arg;
     for (unsigned w = 0;; w = (w + 1) % AHEAD_SLOTS) {
         pthread_mutex_lock(&q->mu);
-        while (q->filled == AHEAD_SLOTS && !q->stop)
-            pthread_cond_wait(&q->freed_cv, &q->mu);
+        if (q->filled == AHEAD_SLOTS)
+            while (q->filled > AHEAD_SLOTS - AHEAD_REFILL && !q->stop)
+                pthread_cond_wait(&q->freed_cv, &q->mu);
         bool stop = q->stop;
         pthread_mutex_unlock(&q->mu);
         if (stop)
@@ -109,8 +111,8 @@ gs_kpr_status kp_ahead_next(kp_ahead *q, const gs_kpframe **f, const kp_ahead_co
                 return s->end;
             }
             pthread_mutex_lock(&q->mu);
-            q->filled--;
-            pthread_cond_signal(&q->freed_cv);
+            if (--q->filled == AHEAD_SLOTS - AHEAD_REFILL)
+                pthread_cond_signal(&q->freed_cv);
             pthread_mutex_unlock(&q->mu);
             q->cur = (q->cur + 1) % AHEAD_SLOTS;
             q->have_cur = false;
