@@ -145,7 +145,7 @@ static void test_gym_jump_same_output_with_prefetch(void)
     char clip[512];
     if (!have("data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", clip, sizeof clip))
         TEST_IGNORE_MESSAGE("jumpvision_jumps or the pose networks are absent");
-    same_output(clip, "--model lite", {1, 2});
+    same_output(clip, "--model lite", {1, 2, 4});
     same_output(clip, "--model lite --threads 2", {2});
     same_output(clip, "--model full --threads 1", {2});
 }
