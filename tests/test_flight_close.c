@@ -97,6 +97,8 @@ typedef struct {
     double outliers;      /* the share of frames whose body is displaced by up to 40 px */
 } stream;
 
+static bool close_whole; /* run: every close whole in its landing's frame (gs_pipeline_set_close_whole) */
+
 static double storage[(4096 * (sizeof(gs_sample) + sizeof(float))) / sizeof(double) + 8];
 
 static void run(const jumps *j, const stream *st, bool at_once, capture *cap)
@@ -110,6 +112,7 @@ static void run(const jumps *j, const stream *st, bool at_once, capture *cap)
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &cfg, st->point ? GS_LAYOUT_POINT : GS_LAYOUT_COCO17, storage,
                                               sizeof storage, on_event, cap));
     gs_pipeline_set_trace(&p, at_once);
+    gs_pipeline_set_close_whole(&p, close_whole);
     rng = 88172645463325252ull;
     const double stature_px = 600.0, q = 1.75 / stature_px, noise = st->noise_px > 0.0 ? st->noise_px : 1.0;
     int64_t pause_us = 0;
@@ -184,6 +187,21 @@ static void test_jumps_120fps(void)
     long frame[JUMPS_MAX];
     TEST_ASSERT_EQUAL_INT(4, landings(&j, &st, frame));
     TEST_ASSERT_TRUE(compare(&j, &st) > 0);  /* the closes did wait */
+}
+
+/* gs_pipeline_set_close_whole: the same lines, each jump event in its landing's frame. */
+static void test_close_whole_in_landing_frame(void)
+{
+    jumps j = {1.0, 0.5, 1.2, 4};
+    stream st = {120.0, 512, (long)(8.0 * 120.0), -1, false, 0.0, 0.0};
+    static capture ref, got;
+    run(&j, &st, true, &ref);
+    close_whole = true;
+    run(&j, &st, false, &got);
+    close_whole = false;
+    TEST_ASSERT_EQUAL_STRING(ref.out, got.out);
+    TEST_ASSERT_EQUAL_INT(4, got.n_jumps);
+    for (int k = 0; k < got.n_jumps; k++) TEST_ASSERT_EQUAL_INT(ref.jump_frame[k], got.jump_frame[k]);
 }
 
 /* The stream ends at every frame from the first landing's detection to a few past it
@@ -284,6 +302,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_jumps_120fps);
+    RUN_TEST(test_close_whole_in_landing_frame);
     RUN_TEST(test_stream_ends_while_pending);
     RUN_TEST(test_jumps_close_together);
     RUN_TEST(test_break_after_landing);

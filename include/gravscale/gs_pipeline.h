@@ -45,6 +45,10 @@ void gs_pipeline_set_track(gs_pipeline *p, uint32_t track);
 void gs_pipeline_set_judge(gs_pipeline *p, gs_jump_judge_fn fn, void *ctx);
 /* Also emit GS_EV_STATE / GS_EV_SAMPLE / GS_EV_FIT trace events. */
 void gs_pipeline_set_trace(gs_pipeline *p, bool on);
+/* Run every flight's close whole in its landing's frame rather than in steps over the
+ * next frames (GS_CLOSE_LAG_FRAMES): for a caller whose judge or event handler reads
+ * that frame's own state, such as the video detectors. The events are the same. */
+void gs_pipeline_set_close_whole(gs_pipeline *p, bool on);
 
 /* One frame of keypoints (gs_layout_kp_count(layout) of them) at t_us
  * microseconds. t_us must not decrease (GS_EORDER, sample dropped); equal

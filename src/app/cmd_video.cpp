@@ -360,6 +360,8 @@ public:
             }
             gs_pipeline_set_track(&tp->p, static_cast<uint32_t>(pipes_.size()));
             gs_pipeline_set_trace(&tp->p, app_.trace_on);
+            // the judge reads the landing frame's state (the ball's size, the scene's motion)
+            gs_pipeline_set_close_whole(&tp->p, true);
             gs_pipeline_set_judge(&tp->p, judge_jump, &app_);
             pipes_.push_back(std::move(tp));
         }

@@ -1576,7 +1576,7 @@ static bool close_due(gs_flight *f)
     gs_close *c = &f->close;
     uint32_t head = idx_of(f, gs_ring_head(f->ring));
     int64_t t_new_us = f->ring->t_last_us;
-    if (f->trace || head - c->head >= GS_CLOSE_LAG_FRAMES || head + 1u - c->low >= f->ring->capacity ||
+    if (f->trace || f->close_whole || head - c->head >= GS_CLOSE_LAG_FRAMES || head + 1u - c->low >= f->ring->capacity ||
         (t_new_us != GS_T_NONE && t_new_us - c->t_end_us >= CLOSE_LAG_US))
         return true;
     while (c->checked < head)

@@ -110,6 +110,16 @@ void gs_pipeline_set_trace(gs_pipeline *p, bool on)
     if (p) p->flight.trace = on;
 }
 
+void gs_pipeline_set_close_whole(gs_pipeline *p, bool on)
+{
+#if GS_CLOSE_LAG_FRAMES > 0
+    if (p) p->flight.close_whole = on;
+#else
+    (void)p;
+    (void)on;
+#endif
+}
+
 static void emit_session(gs_pipeline *p, bool ended, const char *reason)
 {
     gs_event ev;
