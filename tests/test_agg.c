@@ -111,6 +111,48 @@ static void test_median_and_spread_widen(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 1.755, ha.height_m);
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* median absolute deviation from the median, by sorting (the reference) */
+static double mad_by_sort(const double *v, int n)
+{
+    double s[GS_AGG_MAX], d[GS_AGG_MAX];
+    memcpy(s, v, (size_t)n * sizeof *s);
+    qsort(s, (size_t)n, sizeof *s, cmp_double);
+    double med = (n & 1) ? s[n / 2] : 0.5 * (s[n / 2 - 1] + s[n / 2]);
+    for (int i = 0; i < n; i++) d[i] = fabs(s[i] - med);
+    qsort(d, (size_t)n, sizeof *d, cmp_double);
+    return (n & 1) ? d[n / 2] : 0.5 * (d[n / 2 - 1] + d[n / 2]);
+}
+
+static void test_spread_follows_mad(void)
+{
+    /* With zero SEs the half-width is the MAD times a factor of n alone: two sets of one
+     * size (heights on a 1 cm grid: ties, both parities) differ in width as in MAD. */
+    for (int n = 2; n <= GS_AGG_MAX; n++) {
+        double v[2][GS_AGG_MAX], half[2], mad[2];
+        for (int k = 0; k < 2; k++) {
+            gs_agg a;
+            gs_ev_height h;
+            gs_agg_init(&a);
+            for (int i = 0; i < n; i++) {
+                v[k][i] = (double)(float)(1.5 + 0.01 * (double)(rng_u64() % (k ? 40u : 15u)));  /* (held as floats) */
+                gs_agg_add(&a, v[k][i], 0.0);
+            }
+            gs_agg_get(&a, &h);
+            half[k] = 0.5 * (h.ci95_hi_m - h.ci95_lo_m);
+            mad[k] = mad_by_sort(v[k], n);
+        }
+        if (mad[0] > 0.0 && mad[1] > 0.0) {
+            TEST_ASSERT_DOUBLE_WITHIN(1e-9 * half[1] / mad[1], half[0] / mad[0], half[1] / mad[1]);
+        }
+    }
+}
+
 static void test_non_finite_and_nonpositive_count_as_rejected(void)
 {
     static const struct { double v, se; bool accepted; } rows[] = {
@@ -232,6 +274,7 @@ int main(void)
     RUN_TEST(test_single_flight_interval);
     RUN_TEST(test_two_equal_flights_use_known_se);
     RUN_TEST(test_median_and_spread_widen);
+    RUN_TEST(test_spread_follows_mad);
     RUN_TEST(test_non_finite_and_nonpositive_count_as_rejected);
     RUN_TEST(test_window_keeps_newest);
     RUN_TEST(test_monte_carlo_coverage);

@@ -63,11 +63,41 @@ static void sort_asc(gs_real *v, uint32_t n)
     }
 }
 
+/* the median of v[0..n) sorted ascending (n >= 1) */
+static gs_real median_sorted(const gs_real *v, uint32_t n)
+{
+    return (n & 1u) ? v[n / 2] : GS_R(0.5) * (v[n / 2 - 1] + v[n / 2]);
+}
+
 gs_real gs_sort_median(gs_real *v, uint32_t n)
 {
     sort_asc(v, n);
-    return (n & 1u) ? v[n / 2] : GS_R(0.5) * (v[n / 2 - 1] + v[n / 2]);
+    return median_sorted(v, n);
 }
+
+#ifndef __OPTIMIZE_SIZE__
+/* The median of |v[i] - med| over v[0..n) sorted ascending: the deviations fall below med
+ * and rise above it, two sorted runs merged (in dev) up to the median's rank instead of a
+ * sort. The same value as gs_sort_median of them. */
+static gs_real median_abs_dev_sorted(const gs_real *v, uint32_t n, gs_real med, gs_real *dev)
+{
+    uint32_t hi = 0, need = n / 2u + 1u;
+    while (hi < n && v[hi] < med) hi++;
+    uint32_t lo = hi;  /* v[lo - 1] is the next below med, v[hi] the next at or above it */
+    for (uint32_t m = 0; m < need; m++) {
+        gs_real below = lo > 0 ? GS_FABSR(v[lo - 1u] - med) : (gs_real)INFINITY;
+        gs_real above = hi < n ? GS_FABSR(v[hi] - med) : (gs_real)INFINITY;
+        if (below < above) {
+            dev[m] = below;
+            lo--;
+        } else {
+            dev[m] = above;
+            hi++;
+        }
+    }
+    return median_sorted(dev, n);
+}
+#endif
 
 void gs_agg_init(gs_agg *a)
 {
@@ -149,11 +179,16 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         half = GS_R(1.96) * GS_SQRT(se * se + tau * tau);
     } else {
         /* Between-flight spread: MAD, scaled to a normal sigma, small-sample corrected. */
+#ifdef __OPTIMIZE_SIZE__
         for (uint32_t i = 0; i < n; i++) {
             dev[i] = GS_FABSR(v[i] - med);
         }
+        gs_real mad = gs_sort_median(dev, n);
+#else
+        gs_real mad = median_abs_dev_sorted(v, n, med, dev);
+#endif
         gs_real corr = n < 10 ? k_mad_corr[n] : (gs_real)n / ((gs_real)n - GS_R(0.8));
-        gs_real spread = MAD_TO_SIGMA * gs_sort_median(dev, n) * corr;
+        gs_real spread = MAD_TO_SIGMA * mad * corr;
         /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
         gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
         gs_real sigma = spread > se_floor ? spread : se_floor;

@@ -24,6 +24,7 @@
 #define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
 #define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
 #define LAND_G_REL  5.8f   /* gravity in statures per s^2 (9.81 m/s^2 over a 1.7 m body): a landing foot's fall */
+#define WAIT_SLOTS  2u    /* history slots 0 and 1: the frame after the pending one, and the pending one */
 
 /* one copy: called for nearly every height read */
 static NOINLINE bool fin(float v) { return gs_finite_f(v); }
@@ -62,17 +63,18 @@ static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float fro
     ev->from_px = from_px;
 }
 
-/* slot of the frame `back` frames before the newest (0: the newest) */
-static NOINLINE unsigned slot(const gs_feet *ft, uint32_t back) { return (ft->n - 1u - back) % GS_FEET_HIST; }
+/* slot of the frame `back` frames before the newest (0: the newest): the history moves
+ * one slot per frame examined, so that every read is at a fixed offset */
+static unsigned slot(uint32_t back) { return back + WAIT_SLOTS; }
 
 /* frames held in the history (two slots are the pending frame and the one after it) */
-static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - 2u ? ft->n : GS_FEET_HIST - 2u; }
+static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - WAIT_SLOTS ? ft->n : GS_FEET_HIST - WAIT_SLOTS; }
 
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
-static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(ft, 0)] - ft->t_us[slot(ft, back)]; }
+static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
 
 /* the point's height `back` frames before the newest */
-static NOINLINE float u_at(const gs_feet *ft, const gs_foot *f, uint32_t back) { return f->u_px[slot(ft, back)]; }
+static NOINLINE float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
 
 /* The newest crossing of level L by the point within the history, rising (up) or falling,
  * interpolated between the two frames around it; GS_T_NONE when none. */
@@ -80,10 +82,10 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
 {
     uint32_t newer = UINT32_MAX;  /* the newer frame of the pair: a missing or outlier frame is bridged */
     for (uint32_t b = 0; b < held(ft); b++) {
-        float u0 = u_at(ft, f, b);
+        float u0 = u_at(f, b);
         if (!fin(u0)) continue;
         if (newer != UINT32_MAX) {
-            float u1 = u_at(ft, f, newer);
+            float u1 = u_at(f, newer);
             if ((u0 <= L) == up && (u1 <= L) != up) {  /* (both finite) */
                 uint32_t a0 = age_us(ft, b), a1 = age_us(ft, newer);
                 float w = (L - u0) / (u1 - u0);
@@ -109,7 +111,7 @@ static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L,
     uint32_t ak[GS_FEET_HIST];  /* their ages, us */
     unsigned n = 0;
     for (uint32_t b = 0; b < held(ft); b++) {
-        float u = u_at(ft, f, b);
+        float u = u_at(f, b);
         if (fin(u)) {
             uk[n] = u;
             ak[n++] = age_us(ft, b);
@@ -151,9 +153,9 @@ static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L,
  * (a lone outlier does not move it); the height `back` alone when those are not all known */
 static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
 {
-    float a = u_at(ft, f, back);
+    float a = u_at(f, back);
     if (back + 3u > held(ft)) return a;
-    float b = u_at(ft, f, back + 1u), c = u_at(ft, f, back + 2u);
+    float b = u_at(f, back + 1u), c = u_at(f, back + 2u);
     if (!fin(a) || !fin(b) || !fin(c)) return a;
     if (a > b) { float t = a; a = b; b = t; }
     if (b > c) b = c;
@@ -178,7 +180,7 @@ static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
 {
     if (back + 2 > held(ft)) return NAN;
     uint32_t dt = age_us(ft, back + 1) - age_us(ft, back);
-    return (u_at(ft, f, back) - u_at(ft, f, back + 1)) / ((float)dt * 1e-6f);
+    return (u_at(f, back) - u_at(f, back + 1)) / ((float)dt * 1e-6f);
 }
 
 
@@ -248,7 +250,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float m = med3_at(ft, f, 0);
     bool st = still(ft, f, m, size_px);
     if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
-        float d2 = GS_FABS(u - 2.0f * u_at(ft, f, 1) + u_at(ft, f, 2)) / 1.954f;
+        float d2 = GS_FABS(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
         if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
         if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
     }
@@ -283,17 +285,21 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
  * way, by more than SPIKE_REL of the size (feet do not jump there and back in a frame). */
 static void process_pending(gs_feet *ft, const float *next)
 {
-    unsigned s = ft->n % GS_FEET_HIST;
+    unsigned s = WAIT_SLOTS - 1u;  /* the pending frame's */
     float size = ft->pend_size_px, spike = SPIKE_REL * size;
     for (int p = 0; p < GS_FEET_POINTS && next && ft->n > 0; p++) {
-        float a = u_at(ft, &ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
+        float a = u_at(&ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
         if ((b - a > spike && b - c > spike) || (a - b > spike && c - b > spike)) ft->pt[p].u_px[s] = NAN;
     }
     ft->n++;
+    for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) {  /* the history one slot older */
+        ft->t_us[k] = ft->t_us[k - 1u];
+        for (int p = 0; p < GS_FEET_POINTS; p++) ft->pt[p].u_px[k] = ft->pt[p].u_px[k - 1u];
+    }
     ft->t_prev_us = ft->t_last_us;
     ft->t_last_us = ft->pend_t_us;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
-        float u = ft->pt[p].u_px[s];
+        float u = u_at(&ft->pt[p], 0);  /* the pending frame, now the newest */
         if (!fin(u)) ft->unseen_us = ft->t_last_us;
         point_step(ft, &ft->pt[p], ft->t_last_us, u, size);
     }
@@ -323,7 +329,7 @@ void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
     float u[GS_FEET_POINTS];
     for (int p = 0; p < GS_FEET_POINTS; p++) u[p] = x_px[p] * ux + y_px[p] * uy;
     /* this frame waits in the slot after the pending one until the next shows it is no outlier */
-    unsigned w = (ft->n + ft->pending) % GS_FEET_HIST;
+    unsigned w = WAIT_SLOTS - 1u - ft->pending;
     ft->t_us[w] = (uint32_t)t_us;
     for (int p = 0; p < GS_FEET_POINTS; p++) ft->pt[p].u_px[w] = u[p];
     if (ft->pending) process_pending(ft, u);
