@@ -35,6 +35,7 @@
 #endif
 
 #include "gs_inline.h"
+#include "gs_median.h"
 
 
 /* tuning: thresholds in units of the noise or of the object's size */
@@ -93,7 +94,7 @@ static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
  * adds cost code on a 32-bit core): the ring index of offset i, and the offset of a
  * held ring index (held samples are never before the base: see rebase). */
 static uint64_t ring_idx(const gs_flight *f, uint32_t i) { return f->base + i; }
-static NOINLINE uint32_t idx_of(const gs_flight *f, uint64_t ring_i) { return (uint32_t)(ring_i - f->base); }
+static uint32_t idx_of(const gs_flight *f, uint64_t ring_i) { return (uint32_t)(ring_i - f->base); }
 
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 static const gs_sample_full *at(const gs_flight *f, uint32_t i, gs_sample_full *buf)
@@ -124,7 +125,7 @@ static NOINLINE bool span_over(int64_t t1_us, int64_t t0_us, int64_t span_us)
 }
 
 /* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side. */
-static NOINLINE int64_t past_us(int64_t t_us, int64_t T_us, int side)
+static int64_t past_us(int64_t t_us, int64_t T_us, int side)
 {
     int64_t d = t_us - T_us;
     return side < 0 ? -d : d;
@@ -231,6 +232,9 @@ static gs_real median_f(float *v, uint32_t n)
     float lo = v[0];
     for (int32_t i = 1; i < k; i++) lo = v[i] > lo ? v[i] : lo;
     return GS_R(0.5) * ((gs_real)lo + (gs_real)v[k]);
+#else
+    /* gs_real is float on the device: the aggregate's insertion sort, the same values */
+    if (GS_REAL_IS_FLOAT) return gs_sort_median((gs_real *)(void *)v, n);
 #endif
     for (uint32_t i = 1; i < n; i++) {
         float x = v[i];
@@ -347,13 +351,13 @@ static gs_real fit_sigma(const gs_flight *f, const gs_fit_result *r)
     return s;
 }
 
-/* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) */
+/* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) (not finite
+ * where R is singular) */
 static gs_real pred_var_factor(const gs_fit *fit, int64_t t_us)
 {
     gs_real tau = gs_time_span_s(t_us, fit->t0_us) / fit->tscale_s;
     gs_real x0 = GS_R(1.0), x1 = tau, x2 = tau * tau;
     const gs_real *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
-    if (r[0] == GS_R(0.0) || r[3] == GS_R(0.0) || r[5] == GS_R(0.0)) return (gs_real)INFINITY;
     gs_real z0 = x0 / r[0];
     gs_real z1 = (x1 - r[1] * z0) / r[3];
     gs_real z2 = (x2 - r[2] * z0 - r[4] * z1) / r[5];
@@ -533,7 +537,7 @@ static bool gravity_agrees(const gs_flight *f, const gs_fit_result *r)
  * body's (a jump in place drifts a few cm/s; a stride travels metres a second) */
 static bool running_stride(const gs_flight *f, const gs_fit_result *r, uint32_t n, bool feet, gs_real size_px)
 {
-    if (IS_RIGID(f) || feet || n >= 2u * f->cfg->min_samples || !finite_r(size_px)) return false;
+    if (IS_RIGID(f) || feet || n >= 2u * f->cfg->min_samples) return false;
     gs_real gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
     gs_real v_across = GS_FABSR(r->vx_px_s * gy - r->vy_px_s * gx);  /* perpendicular to gravity */
     return v_across > STRIDE_REL * size_px;
@@ -926,8 +930,8 @@ static int64_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int
 {
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
     gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
+    /* all held: the contact samples were tested, the flight lies between them and the newest */
     int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
-    if (t_lo == GS_T_NONE || t_hi == GS_T_NONE || t_in == GS_T_NONE || t_out == GS_T_NONE) return GS_T_NONE;
     if (t_hi <= t_lo) return GS_T_NONE;
     /* search between the outermost contact sample and a little inside the flight */
     int64_t dt = frame_dt_us(f);
@@ -1080,7 +1084,7 @@ static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, 
  * deviation against gravity keeps growing, as under a constant contact force
  * (after an impact the body soon stops following it). Returns how many;
  * *outer = the outermost, *first = the nearest. */
-static NOINLINE uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t edge, int side,
+static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t edge, int side,
                             uint32_t head, uint32_t *outer, uint32_t *first)
 {
     uint32_t floor_idx = history_floor(f);
@@ -1140,8 +1144,8 @@ static bool inside_edge(const gs_flight *f, uint32_t i, int64_t T, int side, uin
 
 /* The flight's outermost sample on one side: from `from` step toward `to` (inward)
  * until a sample is inside the flight (inside_edge) or `to` is reached. */
-static NOINLINE uint32_t trim_edge(const gs_flight *f, uint32_t from, uint32_t to, int64_t T, int side,
-                                   uint32_t edge)
+static uint32_t trim_edge(const gs_flight *f, uint32_t from, uint32_t to, int64_t T, int side,
+                          uint32_t edge)
 {
     uint32_t i = from;
     while (i != to && !inside_edge(f, i, T, side, edge)) i = side < 0 ? i + 1 : i - 1;
@@ -1232,7 +1236,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         DBG("feet: com %lld..%lld apex %lld -> F0 %lld F1 %lld floors %.1f %.1f before %.1f\n", (long long)c0,
             (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, c->floor_off_px, c->floor_on_px,
             c->floor_before_px);
-        if (F0 != GS_T_NONE && F1 != GS_T_NONE && F1 <= F0) c->F0_us = c->F1_us = F0 = F1 = GS_T_NONE;
+        if (F1 != GS_T_NONE && F1 <= F0) c->F0_us = c->F1_us = F0 = F1 = GS_T_NONE;
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
          * rested, as in quick hops, say nothing: the COM times the flight) */
@@ -1335,6 +1339,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
     j->n_outliers = n_out;
     j->height_m = j->height_se_m = NAN;  /* the other fields are all set below (memset: not accepted, no reason) */
 
+    /* (a size is a median of finite sizes or NaN: a comparison with an unknown one is false) */
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
@@ -1356,13 +1361,13 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         /* a rebound: the ground contact since the last landing, no stance between */
         j->contact_time_s = j->rsi = NAN;
         if (f->last_land_us != GS_T_NONE && T0 > f->last_land_us && T0 - f->last_land_us <= CONTACT_MAX_US &&
-            !(f->stand_last_us != GS_T_NONE && f->stand_last_us > f->last_land_us)) {
+            !(f->stand_last_us > f->last_land_us)) {
             j->contact_time_s = gs_time_span_s(T0, f->last_land_us);
             j->rsi = j->jump_height_m / j->contact_time_s;
         }
         if (!IS_RIGID(f) && !feet) j->warnings |= GS_WARN_COM_TIMED;
         /* the stature only where the body stood at the flight's place (its feet on the same floor row) */
-        if (feet && finite_r(size) && f->feet.epoch == f->stand_floor_epoch && finite_r(f->stand_floor_px) &&
+        if (feet && f->feet.epoch == f->stand_floor_epoch && finite_r(f->stand_floor_px) &&
             finite_r(c->floor_off_px) && GS_FABSR((gs_real)(c->floor_off_px - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
             j->warnings |= GS_WARN_DEPTH_CHANGED;
             size = size_se = NAN;
@@ -1385,7 +1390,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
 
-        if ((GS_WITH_POSE && c->fell) || (F1 != GS_T_NONE && finite_r(gsize) && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
+        if ((GS_WITH_POSE && c->fell) || (F1 != GS_T_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
         else if (GS_WITH_POSE && c->feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;
@@ -1395,7 +1400,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             j->reason = GS_REJ_GAP;
         else if (!finite_r(size) && !sizeless_ok)
             j->reason = GS_REJ_NO_SIZE;
-        else if (finite_r(gsize) && fr.rms_px > (gs_real)f->cfg->max_rms_rel * gsize)
+        else if (fr.rms_px > (gs_real)f->cfg->max_rms_rel * gsize)
             j->reason = GS_REJ_LARGE_RESIDUAL;
         else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)f->cfg->max_a_se_rel) || running_stride(f, &fr, n_in, feet, gsize))
             j->reason = GS_REJ_UNCERTAIN_A;
@@ -1405,7 +1410,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             j->reason = GS_REJ_IMPLAUSIBLE_A;
         j->accepted = j->reason == GS_REJ_NONE;
         /* the same posture at both ends puts the COM at the same height (feet times only) */
-        if (feet && finite_r(gsize)) {
+        if (feet) {
             gs_real du = fit_u_at(&fr, T1) - fit_u_at(&fr, T0);
             if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) j->warnings |= GS_WARN_COM_MISMATCH;
         }
@@ -1413,8 +1418,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
         if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
         if (c->truncated) j->warnings |= GS_WARN_CLIPPED;
-        if (f->n_flights > 0 && finite_r(f->last_g_dir_deg) &&
-            GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))
+        if (GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))  /* (NaN before an accepted flight) */
             j->warnings |= GS_WARN_GRAVITY_TILT;
     }
 
@@ -1938,7 +1942,7 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
  * the base moves to GS_FLIGHT_IDX_KEEP before it (the ring holds fewer samples: no held
  * sample falls before it). A stored index before the new base (never held) becomes 0,
  * equally unheld and before every held one. */
-static NOINLINE void rebase(gs_flight *f)
+static void rebase(gs_flight *f)
 {
     static const uint16_t idx_fields[] = {
         offsetof(gs_flight, next), offsetof(gs_flight, quiet_from), offsetof(gs_flight, last_idx),
