@@ -356,7 +356,7 @@ int64_t gs_feet_takeoff(const gs_feet *ft, int64_t from_us, int64_t to_us, float
     for (int p = 0; p < GS_FEET_POINTS; p++)
         for (int k = 0; k < GS_FEET_LOG; k++) {
             int64_t t = ft->pt[p].touch[k].t_us;
-            if (t != GS_T_NONE && t > lift[p] && t < best) return GS_T_NONE;
+            if (t > lift[p] && t < best) return GS_T_NONE;  /* (GS_T_NONE is below any time) */
         }
     if (level_px) *level_px = sum / (float)GS_FEET_POINTS;
     return best;
@@ -370,7 +370,8 @@ int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float
             const gs_feet_event *e = &ft->pt[p].touch[k];
             /* a recrossing the point is still falling fast past is not a landing (yet) */
             if (k == 0 && ft->pt[p].touch_unsure == 2 && ft->pt[p].falling) continue;
-            if (e->t_us != GS_T_NONE && e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
+            /* (GS_T_NONE, the lowest int64, is never after from_us) */
+            if (e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
                 best = e;
         }
     if (level_px) *level_px = best ? best->level_px : NAN;
