@@ -165,10 +165,9 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
     if (p->finished) return GS_ESTATE;
     if (s->t_us == GS_T_NONE) return GS_EINVAL;
     const int64_t last_us = p->ring.t_last_us;  /* the newest frame's, GS_T_NONE before the first */
-    if (last_us != GS_T_NONE) {
-        if (s->t_us < last_us) return GS_EORDER;
-        if (s->t_us == last_us) return GS_OK;  /* a repeated frame carries nothing new */
-    }
+    /* (GS_T_NONE before the first frame is the lowest int64: neither test holds) */
+    if (s->t_us < last_us) return GS_EORDER;
+    if (s->t_us == last_us) return GS_OK;  /* a repeated frame carries nothing new */
     if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
      * left open must close on them first (as it would on any long gap); the

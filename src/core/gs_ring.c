@@ -97,7 +97,7 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     if (!r || !s || !r->buf || !gs_time_ok(s->t_us)) {
         return GS_EINVAL;
     }
-    if (r->t_last_us != GS_T_NONE && s->t_us < r->t_last_us) {
+    if (s->t_us < r->t_last_us) {  /* (GS_T_NONE before the first: the lowest int64) */
         return GS_EORDER;
     }
     gs_ring_store(r, s);
