@@ -2,7 +2,8 @@
  * gs_pipeline_push_com_us, as the replay runs it with the COM computed in its
  * reader thread) against the one-step gs_pipeline_push_keypoints_us as the
  * reference: table-driven over layouts, configs and awkward frames, every
- * status, sample, fit and event the same, byte for byte as JSON. */
+ * status, sample, fit and event the same, byte for byte as JSON; and a pipeline whose
+ * init failed refuses frames. */
 #include "unity.h"
 #include "gravscale/gravscale.h"
 #include "gs_kpread.h"
@@ -243,10 +244,32 @@ void test_push_com_uses_the_given_com(void)
     free(store);
 }
 
+/* A ring capacity the ring refuses (not a power of two) fails the init; the pipeline then
+ * refuses every frame and the flush instead of using a ring it does not have. */
+void test_failed_init_refuses_frames(void)
+{
+    load_sample();
+    gs_core_config cfg;
+    gs_core_config_default(&cfg);
+    cfg.ring_capacity = 100;
+    size_t bytes = gs_pipeline_storage_bytes(&cfg);
+    void *store = malloc(bytes);
+    gs_pipeline p;
+    ev_log log = {0};
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_init(&p, &cfg, GS_LAYOUT_COCO17, store, bytes, on_ev, &log));
+    TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_push_keypoints_us(&p, 1000, g_frames[0].kp));
+    TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_push_point_us(&p, 2000, 320.0f, 400.0f, 1.0f, 34.0f));
+    TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_flush(&p));
+    TEST_ASSERT_EQUAL(0, (int)log.len);
+    free(log.text);
+    free(store);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_two_steps_give_the_one_step_events);
     RUN_TEST(test_push_com_uses_the_given_com);
+    RUN_TEST(test_failed_init_refuses_frames);
     return UNITY_END();
 }

@@ -174,6 +174,29 @@ static void test_push_copies_sample(void)
     TEST_ASSERT_FALSE(gs_ring_get(&g_r, 1, &g));
 }
 
+/* gs_ring_store (the pipeline's, after its own checks) stores as gs_ring_push does: the same
+ * slots, window and eviction by time span, byte for byte. */
+static void test_store_is_push_unchecked(void)
+{
+    static gs_sample mem[CAP];
+    memset(mem, CANARY_BYTE, sizeof mem);  /* as g_mem: unwritten slots compare equal */
+    gs_ring r;
+    TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_init(&r, mem, CAP));
+    static const int64_t t_us[] = {5, 9, 9, 400, GS_RING_SPAN_US - 3, GS_RING_SPAN_US + 7, 3 * GS_RING_SPAN_US,
+                                   3 * GS_RING_SPAN_US + 1};
+    for (size_t k = 0; k < sizeof t_us / sizeof t_us[0]; k++) {
+        gs_sample_full s = mk(k);
+        s.t_us = t_us[k];
+        s.size_px = 100.0f + (float)k;
+        TEST_ASSERT_EQUAL_INT(GS_OK, gs_ring_push(&g_r, &s));
+        gs_ring_store(&r, &s);
+        TEST_ASSERT_TRUE(gs_ring_head(&r) == gs_ring_head(&g_r) && gs_ring_oldest(&r) == gs_ring_oldest(&g_r));
+        TEST_ASSERT_TRUE(r.t_last_us == g_r.t_last_us);
+        TEST_ASSERT_EQUAL_MEMORY(&g_mem[1], mem, sizeof mem);
+    }
+    TEST_ASSERT_TRUE(gs_ring_count(&r) < 8u);  /* the span evicted some */
+}
+
 /* ---- the packed 16-byte form ------------------------------------------------------------ */
 
 static gs_sample_full roundtrip(float size_px, float w, float upright)
@@ -399,5 +422,6 @@ int main(void)
     RUN_TEST(test_time_wraps_every_71_minutes);
     RUN_TEST(test_time_span_evicts);
     RUN_TEST(test_time_order_and_bad_times);
+    RUN_TEST(test_store_is_push_unchecked);
     return UNITY_END();
 }

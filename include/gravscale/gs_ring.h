@@ -36,6 +36,9 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity);
  * beyond GS_T_MAX_US); GS_EORDER: s is older than the newest sample (an equal
  * time is stored). */
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s);
+/* gs_ring_push without its checks, for a caller that made them (r initialised, s->t_us
+ * gs_time_ok and not older than the newest sample). */
+void gs_ring_store(gs_ring *r, const gs_sample_full *s);
 
 /* The accessors below are read per sample by the fits and the flight: inline where
  * the build optimises for speed (hosts), one out-of-line copy in gs_ring.c where it

@@ -8,6 +8,7 @@
 
 #include "gravscale/gs_agg.h"
 
+#include "gs_finite.h"
 #include "gs_median.h"
 
 /* With one flight the between-flight scatter cannot be seen; a per-flight
@@ -203,7 +204,7 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         gs_real k = n < 6 ? k_median_se[n] : MEDIAN_SE_FACTOR;
         half = q * k * sigma / GS_SQRT((gs_real)n);
     }
-    if (isfinite(half)) {
+    if (gs_finite_r(half)) {
         out->ci95_lo_m = med - half;
         out->ci95_hi_m = med + half;
     }

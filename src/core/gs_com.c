@@ -118,7 +118,7 @@ static const seg_table k_tables[3] = {
  * position is finite (c == 0 is missing even with min_conf 0). */
 static bool kp_usable(const gs_kp *q, float min_conf)
 {
-    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && gs_finite_f(q->x_px) && gs_finite_f(q->y_px);
+    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && gs_finite2_f(q->x_px, q->y_px);
 }
 
 static float conf01(float c)
@@ -769,7 +769,7 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         return GS_EINVAL;
     }
 
-    if (layout == GS_LAYOUT_POINT) {
+    if (GS_WITH_POINT && layout == GS_LAYOUT_POINT) {  /* (a layout not built in was refused above) */
         out->upright = 1.0f; /* a rigid object is always "upright" */
         if (kp_usable(kp, min_conf)) {
             out->x_px = kp->x_px;

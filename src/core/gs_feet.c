@@ -316,7 +316,7 @@ void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
 {
     if (!(size_px > 0) || !(size_px < INFINITY) || t_us == GS_T_NONE) return;
     int64_t last = ft->pending ? ft->pend_t_us : ft->t_last_us;
-    if (last != GS_T_NONE && t_us <= last) return;
+    if (t_us <= last) return;  /* (last GS_T_NONE, the lowest int64: t_us, not GS_T_NONE, passes) */
     float ux = (float)up_x, uy = (float)up_y;
     if (!(ux * ft->up_x + uy * ft->up_y >= UP_COS_MIN)) {
         /* heights along another direction: the levels go, the logged events stay */
@@ -326,12 +326,11 @@ void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
         ft->up_x = ux;
         ft->up_y = uy;
     }
-    float u[GS_FEET_POINTS];
-    for (int p = 0; p < GS_FEET_POINTS; p++) u[p] = x_px[p] * ux + y_px[p] * uy;
     /* this frame waits in the slot after the pending one until the next shows it is no outlier */
     unsigned w = WAIT_SLOTS - 1u - ft->pending;
     ft->t_us[w] = (uint32_t)t_us;
-    for (int p = 0; p < GS_FEET_POINTS; p++) ft->pt[p].u_px[w] = u[p];
+    float u[GS_FEET_POINTS];
+    for (int p = 0; p < GS_FEET_POINTS; p++) ft->pt[p].u_px[w] = u[p] = x_px[p] * ux + y_px[p] * uy;
     if (ft->pending) process_pending(ft, u);
     ft->pending = 1;
     ft->pend_t_us = t_us;
@@ -356,7 +355,7 @@ int64_t gs_feet_takeoff(const gs_feet *ft, int64_t from_us, int64_t to_us, float
     for (int p = 0; p < GS_FEET_POINTS; p++)
         for (int k = 0; k < GS_FEET_LOG; k++) {
             int64_t t = ft->pt[p].touch[k].t_us;
-            if (t != GS_T_NONE && t > lift[p] && t < best) return GS_T_NONE;
+            if (t > lift[p] && t < best) return GS_T_NONE;  /* (GS_T_NONE is below any time) */
         }
     if (level_px) *level_px = sum / (float)GS_FEET_POINTS;
     return best;
@@ -370,7 +369,8 @@ int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float
             const gs_feet_event *e = &ft->pt[p].touch[k];
             /* a recrossing the point is still falling fast past is not a landing (yet) */
             if (k == 0 && ft->pt[p].touch_unsure == 2 && ft->pt[p].falling) continue;
-            if (e->t_us != GS_T_NONE && e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
+            /* (GS_T_NONE, the lowest int64, is never after from_us) */
+            if (e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
                 best = e;
         }
     if (level_px) *level_px = best ? best->level_px : NAN;

@@ -5,13 +5,20 @@
 #include <math.h>
 #include <stdbool.h>
 
+#include "gravscale/gs_types.h"
+
 /* Where the build optimises for size (the Cortex-M4), x - x == 0: a subtraction and a
  * test against zero, shorter there than isfinite's magnitude test; elsewhere isfinite,
  * fewer instructions on hosts. Both are true exactly for finite x. */
 #ifdef __OPTIMIZE_SIZE__
 static inline bool gs_finite_f(float x) { return x - x == 0.0f; }
+/* (x - x) + (y - y) is 0 when both are finite, NaN otherwise: one test for the pair */
+static inline bool gs_finite2_f(float x, float y) { return (x - x) + (y - y) == 0.0f; }
 #else
 static inline bool gs_finite_f(float x) { return isfinite(x); }
+static inline bool gs_finite2_f(float x, float y) { return isfinite(x) && isfinite(y); }
 #endif
+/* a gs_real's finiteness: the float test where gs_real is float */
+static inline bool gs_finite_r(gs_real x) { return sizeof(gs_real) < sizeof(double) ? gs_finite_f((float)x) : isfinite(x); }
 
 #endif

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "gs_dbits.h"
+#include "gs_finite.h"
 
 /* the layout's foot points: toes (BlazePose-33: they leave the floor last and meet it first),
  * else ankles (COCO-17); their lift at the instant a foot leaves, x stature: a toe rolls up on
@@ -14,6 +15,17 @@
 #define TOE_LIFT_REL   0.009f
 #define ANKLE_LIFT_REL 0.064f
 static const uint8_t k_feet_kp[][2] = {{0, 0}, {15, 16}, {31, 32}};  /* by gs_layout */
+
+/* the pipeline's layout (one built in: gs_pipeline_init checks) is the point, or BlazePose-33;
+ * constant where the build has one layout (gs_features.h) */
+static bool is_point(gs_layout l) { return GS_WITH_POINT && (!GS_WITH_POSE || l == GS_LAYOUT_POINT); }
+static bool is_blaze(gs_layout l)
+{
+    return GS_WITH_BLAZEPOSE33 && ((!GS_WITH_POINT && !GS_WITH_COCO17) || l == GS_LAYOUT_BLAZEPOSE33);
+}
+
+/* the pipeline tracks visits (a skeleton layout): always where no point layout is built in */
+static bool has_sessions(const gs_pipeline *p) { return GS_WITH_POSE && (!GS_WITH_POINT || p->sessions); }
 
 #define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~((size_t)(a) - 1u))
 
@@ -54,10 +66,10 @@ static void on_flight_event(void *ctx, const gs_event *ev)
     }
     emit(p, ev);
     if (ev->type != GS_EV_JUMP) return;
-    if (GS_WITH_POSE && p->sessions) gs_session_jump(&p->session, &ev->u.jump);
+    if (has_sessions(p)) gs_session_jump(&p->session, &ev->u.jump);
     if (!ev->u.jump.accepted) {
         gs_agg_reject(&p->agg);
-    } else if (isfinite(ev->u.jump.height_m)) {  /* a jump of unknown stature (no_size, depth_changed) adds none */
+    } else if (gs_finite_r(ev->u.jump.height_m)) {  /* a jump of unknown stature (no_size, depth_changed) adds none */
         gs_agg_add(&p->agg, ev->u.jump.height_m, ev->u.jump.height_se_m);
         emit_height(p, GS_EV_HEIGHT, ev->u.jump.track);
     }
@@ -80,16 +92,18 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     gs_sample *samples = (gs_sample *)storage;
     uint32_t *scratch = (uint32_t *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
     gs_status st = gs_ring_init(&p->ring, samples, cap);
-    if (st != GS_OK) return st;
+    if (st != GS_OK) {
+        p->finished = true;  /* no ring: every push is refused (GS_ESTATE) */
+        return st;
+    }
     gs_agg_init(&p->agg);
-    p->sessions = GS_WITH_POSE && layout != GS_LAYOUT_POINT;
+    p->sessions = GS_WITH_POSE && !is_point(layout);
     if (GS_WITH_POSE)
         gs_session_init(&p->session, gs_time_us_of_cfg_s(cfg->session_absence_s), (gs_real)cfg->session_new_body_rel);
-    st = gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, layout == GS_LAYOUT_POINT,
+    st = gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, is_point(layout),
                         on_flight_event, p);
-    if (st == GS_OK && layout != GS_LAYOUT_POINT)
-        gs_flight_use_feet(&p->flight, layout == GS_LAYOUT_BLAZEPOSE33 ? TOE_LIFT_REL : ANKLE_LIFT_REL,
-                           layout == GS_LAYOUT_BLAZEPOSE33);
+    if (st == GS_OK && !is_point(layout))
+        gs_flight_use_feet(&p->flight, is_blaze(layout) ? TOE_LIFT_REL : ANKLE_LIFT_REL, is_blaze(layout));
     return st;
 }
 
@@ -123,10 +137,9 @@ void gs_pipeline_set_close_whole(gs_pipeline *p, bool on)
 static void emit_session(gs_pipeline *p, bool ended, const char *reason)
 {
     gs_event ev;
-    gs_event h;
-    memset(&h, 0, sizeof h);
-    gs_agg_get(&p->agg, &h.u.height);
-    gs_session_event(&p->session, ended, reason, &h.u.height, p->flight.track, &ev);
+    gs_ev_height h;  /* (gs_session_event reads the stature and its interval) */
+    gs_agg_get(&p->agg, &h);
+    gs_session_event(&p->session, ended, reason, &h, p->flight.track, &ev);
     emit(p, &ev);
 }
 
@@ -134,7 +147,7 @@ static void emit_session(gs_pipeline *p, bool ended, const char *reason)
  * next one starts with its own aggregate and standing size. */
 static void track_session(gs_pipeline *p, const gs_sample_full *s)
 {
-    bool present = s->w >= 0.05f && isfinite(s->x_px) && isfinite(s->y_px);
+    bool present = s->w >= 0.05f && gs_finite2_f(s->x_px, s->y_px);
     const char *why = NULL;
     uint32_t r = gs_session_frame(&p->session, s->t_us, present, gs_flight_stand_at(&p->flight, s->t_us), &why);
     if (r & GS_SESSION_ENDED) {
@@ -152,18 +165,16 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
     if (p->finished) return GS_ESTATE;
     if (s->t_us == GS_T_NONE) return GS_EINVAL;
     const int64_t last_us = p->ring.t_last_us;  /* the newest frame's, GS_T_NONE before the first */
-    if (last_us != GS_T_NONE) {
-        if (s->t_us < last_us) return GS_EORDER;
-        if (s->t_us == last_us) return GS_OK;  /* a repeated frame carries nothing new */
-    }
+    /* (GS_T_NONE before the first frame is the lowest int64: neither test holds) */
+    if (s->t_us < last_us) return GS_EORDER;
+    if (s->t_us == last_us) return GS_OK;  /* a repeated frame carries nothing new */
     if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
      * left open must close on them first (as it would on any long gap); the
      * difference as uint64 is exact for any two accepted times */
     if (last_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
         gs_flight_break(&p->flight);
-    gs_status st = gs_ring_push(&p->ring, s);
-    if (st != GS_OK) return st;
+    gs_ring_store(&p->ring, s);  /* (checked above as gs_ring_push would) */
     if (feet_xy) gs_flight_feet(&p->flight, s->t_us, feet_xy, feet_xy + GS_FEET_POINTS, s->size_px);
     if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;
@@ -178,7 +189,7 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
         p->on_event(p->ctx, &ev);
     }
     gs_flight_update(&p->flight);
-    if (GS_WITH_POSE && p->sessions) track_session(p, s);
+    if (has_sessions(p)) track_session(p, s);
     return GS_OK;
 }
 
@@ -195,7 +206,7 @@ gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp,
     s.t_us = t_us;
     s.x_px = com->x_px;
     s.y_px = com->y_px;
-    s.w = (isfinite(com->x_px) && isfinite(com->y_px)) ? com->w : 0.0f;
+    s.w = gs_finite2_f(com->x_px, com->y_px) ? com->w : 0.0f;
     s.size_px = com->stature_px;
     s.up_x = com->up_x;
     s.up_y = com->up_y;
@@ -203,7 +214,7 @@ gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp,
     float feet[2 * GS_FEET_POINTS];  /* x then y of each point, NaN missing */
     for (int k = 0; k < GS_FEET_POINTS; k++) {
         const gs_kp *f = &kp[k_feet_kp[p->layout][k]];
-        bool seen = p->layout != GS_LAYOUT_POINT && f->c >= p->cfg.min_conf && f->c > 0.0f;
+        bool seen = !is_point(p->layout) && f->c >= p->cfg.min_conf && f->c > 0.0f;
         feet[k] = seen ? f->x_px : NAN;
         feet[GS_FEET_POINTS + k] = seen ? f->y_px : NAN;
     }
@@ -226,7 +237,7 @@ gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, fl
     s.t_us = t_us;
     s.x_px = x_px;
     s.y_px = y_px;
-    s.w = (isfinite(x_px) && isfinite(y_px) && c > 0.0f) ? (c < 1.0f ? c : 1.0f) : 0.0f;
+    s.w = (gs_finite2_f(x_px, y_px) && c > 0.0f) ? (c < 1.0f ? c : 1.0f) : 0.0f;
     s.size_px = size_px;
     s.up_x = NAN;
     s.up_y = NAN;
@@ -265,7 +276,7 @@ gs_status gs_pipeline_flush(gs_pipeline *p)
     if (p->finished) return GS_ESTATE;
     gs_flight_finish(&p->flight);
     p->finished = true;
-    if (GS_WITH_POSE && p->sessions && p->session.open) {
+    if (has_sessions(p) && p->session.open) {
         emit_session(p, true, "end_of_stream");
         gs_session_close(&p->session);
     }

@@ -97,11 +97,17 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     if (!r || !s || !r->buf || !gs_time_ok(s->t_us)) {
         return GS_EINVAL;
     }
+    if (s->t_us < r->t_last_us) {  /* (GS_T_NONE before the first: the lowest int64) */
+        return GS_EORDER;
+    }
+    gs_ring_store(r, s);
+    return GS_OK;
+}
+
+void gs_ring_store(gs_ring *r, const gs_sample_full *s)
+{
     int64_t t = s->t_us;
     if (r->t_last_us != GS_T_NONE) {
-        if (t < r->t_last_us) {
-            return GS_EORDER;
-        }
         /* t - newest as uint64: exact for any two accepted times (up to 2^63) */
         if ((uint64_t)t - (uint64_t)r->t_last_us >= (uint64_t)GS_RING_SPAN_US) {
             r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
@@ -127,7 +133,6 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
     r->last_up_x = s->up_x;
     r->last_up_y = s->up_y;
     r->head++;
-    return GS_OK;
 }
 
 bool gs_ring_get(const gs_ring *r, uint64_t i, gs_sample_full *out)

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_finite.h"
 #include "gs_inline.h"
 #include "gs_median.h"
 
@@ -91,7 +92,7 @@ uint32_t gs_session_frame(gs_session *s, int64_t t_us, bool present, gs_real sta
 /* a known value into a sum and its count, and into the best (largest) when given */
 static NOINLINE void tally(gs_real x, gs_real *sum, uint32_t *n, gs_real *best)
 {
-    if (!isfinite(x)) return;
+    if (!gs_finite_r(x)) return;
     *sum += x;
     ++*n;
     if (best && !(x <= *best)) *best = x; /* NaN best: the first */

@@ -48,31 +48,38 @@ static float bounce_m(float t)
 /* the skeleton's layout: COCO-17 when built in (gs_features.h), else BlazePose-33 */
 #define FW_POSE_LAYOUT (GS_WITH_COCO17 ? GS_LAYOUT_COCO17 : GS_LAYOUT_BLAZEPOSE33)
 
+#if GS_WITH_COCO17
+#define FW_POSE_KP 17
+static int pose_index(int coco) { return coco; }
+#else
+#define FW_POSE_KP 33
+/* the same body in BlazePose-33: its index of each COCO keypoint; the inner and outer
+ * eyes, mouth and hand points unseen; heels and toes by the ankles */
+static int pose_index(int coco)
+{
+    static const uint8_t k_to_blaze[17] = {0, 2, 5, 7, 8, 11, 12, 13, 14, 15, 16, 23, 24, 25, 26, 27, 28};
+    return k_to_blaze[coco];
+}
+#endif
+
 static void push_pose(int64_t t_us, float y_off_px)
 {
     /* a standing skeleton about 530 px tall, lifted by y_off_px (COCO-17 order) */
     static const float k_y[17] = {60, 52, 52, 56, 56, 110, 110, 190, 190, 260, 260, 290, 290, 400, 400, 530, 530};
     static const float k_x[17] = {0, -6, 6, -14, 14, -40, 40, -48, 48, -50, 50, -22, 22, -24, 24, -24, 24};
-    gs_kp kp[GS_WITH_COCO17 ? 17 : 33];
+    gs_kp kp[FW_POSE_KP];
+    if (FW_POSE_KP > 17) memset(kp, 0, sizeof kp);  /* the points COCO-17 lacks: unseen */
     for (int i = 0; i < 17; i++) {
-        kp[i].x_px = 640.0f + k_x[i];
-        kp[i].y_px = 100.0f + k_y[i] - y_off_px;
-        kp[i].c = 0.9f;
+        gs_kp *q = &kp[pose_index(i)];
+        q->x_px = 640.0f + k_x[i];
+        q->y_px = 100.0f + k_y[i] - y_off_px;
+        q->c = 0.9f;
     }
 #if !GS_WITH_COCO17
-    {
-        /* the same body in BlazePose-33: its index of each COCO keypoint; the inner
-         * and outer eyes, mouth and hand points unseen; heels and toes by the ankles */
-        static const uint8_t k_to_blaze[17] = {0, 2, 5, 7, 8, 11, 12, 13, 14, 15, 16, 23, 24, 25, 26, 27, 28};
-        gs_kp coco[17];
-        memcpy(coco, kp, sizeof coco);
-        for (int i = 0; i < 33; i++) kp[i] = (gs_kp){0.0f, 0.0f, 0.0f};
-        for (int i = 0; i < 17; i++) kp[k_to_blaze[i]] = coco[i];
-        for (int s = 0; s < 2; s++) {
-            const gs_kp *ank = &coco[15 + s];
-            kp[29 + s] = (gs_kp){ank->x_px - 4.0f, ank->y_px + 12.0f, 0.9f};  /* heel */
-            kp[31 + s] = (gs_kp){ank->x_px + 30.0f, ank->y_px + 14.0f, 0.9f}; /* foot index */
-        }
+    for (int s = 0; s < 2; s++) {
+        const gs_kp *ank = &kp[pose_index(15 + s)];
+        kp[29 + s] = (gs_kp){ank->x_px - 4.0f, ank->y_px + 12.0f, 0.9f};  /* heel */
+        kp[31 + s] = (gs_kp){ank->x_px + 30.0f, ank->y_px + 14.0f, 0.9f}; /* foot index */
     }
 #endif
     g_status |= (uint32_t)gs_pipeline_push_keypoints_us(&g_pipe, t_us, kp);
