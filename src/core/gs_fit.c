@@ -1496,6 +1496,8 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
         memset(seen, 0, ((n_triples + 31u) / 32u) * sizeof seen[0]);
     }
 #endif
+    /* par_through_usable's common case, decided once */
+    bool all_cached = GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE;
 #if GS_FIT_LMS_TABLE
     uint64_t magic_ab = UINT64_MAX / third + 1u, magic_c = UINT64_MAX / (m - 2 * third) + 1u;
     (void)state;
@@ -1522,7 +1524,8 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
             seen[t >> 5] |= 1u << (t & 31u);
         }
 #endif
-        if (!par_through_usable(wn, ka, kb, kc, &p)) {
+        if (!(all_cached ? par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], &p)
+                         : par_through_usable(wn, ka, kb, kc, &p))) {
             continue;
         }
 #if GS_FIT_FAST
