@@ -1041,13 +1041,13 @@ static double below_key(float key)
 /* median_below over a window the cache holds, in double: sqrt((double)a) < sqrt((double)b)
  * exactly when a < b for floats a, b >= 0 (adjacent floats differ by far more than a
  * double's rounding), so each squared residual's float is compared with the median's
- * (through below_key, without the conversion). The usable samples in rows, two at a time
+ * through T = below_key(the median's float), which the caller takes once per best
+ * median (without the conversion). The usable samples in rows, two at a time
  * where the compiler has vectors; the decision only counts, in any order. */
-static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key)
+static bool median_below_cached(const gs_win *wn, const gs_par *p, double T)
 {
     const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
     gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
-    double T = below_key(med_key);
     uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
 #if GS_FIT_AVX2
     if (fit_avx2()) {
@@ -1484,7 +1484,7 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     uint32_t third = m / 3, k;
     bool found = false;
 #if GS_FIT_FAST
-    float best_key = 0.0f; /* *best_med's squared residual as a float, once found */
+    double best_T = 0.0; /* below_key of *best_med's squared residual as a float, once found */
     /* a short window draws the same triple again and again: its curve, median and
      * verdict are the ones already had, so it is skipped (a bit per possible triple) */
     uint32_t span_c = m - 2 * third, n_triples = third * third * span_c;
@@ -1529,7 +1529,7 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
             continue;
         }
 #if GS_FIT_FAST
-        if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_key)
+        if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_T)
                                                                        : !median_below(wn, &p, *best_med))) {
             continue; /* cannot win: no median needed (m > 3 here: m = 3 stops at the first) */
         }
@@ -1540,7 +1540,7 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
             *best = p;
             found = true;
 #if GS_FIT_FAST
-            best_key = *wn->med_key;
+            best_T = below_key(*wn->med_key);
 #endif
         }
         if (m == 3) {
