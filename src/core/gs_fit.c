@@ -346,6 +346,7 @@ typedef struct {
     gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
     uint32_t *key;            /* the median's selection scratch */
     float *med_key;           /* fast builds: the last median's squared residual, as a float */
+    uint32_t *med_at;         /* fast builds: and its index among the keys */
     gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y, w (4 rows of m) */
     struct gs_wlast *last;    /* fast builds: the last reweighting's sums, solved in full only at the end */
 } gs_win;
@@ -537,53 +538,62 @@ GS_AVX2 static inline void rank_bits_avx2(__m256i x, __m256i v, uint32_t j, uint
     *gt |= (uint32_t)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(v, x))) << (8u * j);
 }
 
+/* Key x ranks k among the keys in v[0..nv) (valid: their lanes): at most k keys lie
+ * below it and at most above = n - 1 - k above it. */
+GS_AVX2 static inline bool rank_is_avx2(const __m256i *v, uint32_t nv, uint32_t x_key, uint32_t valid, uint32_t k,
+                                        uint32_t above)
+{
+    __m256i x = _mm256_set1_epi32((int)(x_key ^ 0x80000000u));
+    uint32_t lt = 0, gt = 0, j;
+    for (j = 0; j < nv; j++) {
+        rank_bits_avx2(x, v[j], j, &lt, &gt);
+    }
+    return ((uint32_t)__builtin_popcount(lt & valid) <= k) & ((uint32_t)__builtin_popcount(gt & valid) <= above);
+}
+
 /* The k-th smallest of n <= 32 keys (k < n) by rank, without data-dependent branches
- * but the one that finds it: key i is it when at most k keys lie below it and at
- * most n - 1 - k above it (unsigned order, as select_key's). */
-GS_AVX2 static uint32_t select_rank_avx2(const uint32_t *key, uint32_t n, uint32_t k)
+ * but the one that finds it (unsigned order, as select_key's). *at: where to look
+ * first (the last median's index: an IRLS step's median is mostly the same sample's),
+ * then where it was found. */
+GS_AVX2 static uint32_t select_rank_avx2(const uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
 {
     uint32_t valid = n == 32u ? ~0u : (1u << n) - 1u, above = n - 1u - k, i;
-    __m256i v0 = rank_lanes_avx2(key, n, 0u), v1 = rank_lanes_avx2(key, n, 1u), v2, v3;
+    __m256i v[4];
+    v[0] = rank_lanes_avx2(key, n, 0u);
+    v[1] = rank_lanes_avx2(key, n, 1u);
     if (n <= 16u) {
-        for (i = 0; i + 1u < n; i++) {
-            __m256i x = _mm256_set1_epi32((int)(key[i] ^ 0x80000000u));
-            uint32_t lt = 0, gt = 0;
-            rank_bits_avx2(x, v0, 0u, &lt, &gt);
-            rank_bits_avx2(x, v1, 1u, &lt, &gt);
-            if (((uint32_t)__builtin_popcount(lt & valid) <= k) & ((uint32_t)__builtin_popcount(gt & valid) <= above)) {
-                return key[i];
-            }
+        if (*at < n && rank_is_avx2(v, 2u, key[*at], valid, k, above)) {
+            return key[*at];
         }
-        return key[n - 1u]; /* no earlier key has rank k: the last has */
-    }
-    v2 = rank_lanes_avx2(key, n, 2u);
-    v3 = rank_lanes_avx2(key, n, 3u);
-    for (i = 0; i + 1u < n; i++) {
-        __m256i x = _mm256_set1_epi32((int)(key[i] ^ 0x80000000u));
-        uint32_t lt = 0, gt = 0;
-        rank_bits_avx2(x, v0, 0u, &lt, &gt);
-        rank_bits_avx2(x, v1, 1u, &lt, &gt);
-        rank_bits_avx2(x, v2, 2u, &lt, &gt);
-        rank_bits_avx2(x, v3, 3u, &lt, &gt);
-        if (((uint32_t)__builtin_popcount(lt & valid) <= k) & ((uint32_t)__builtin_popcount(gt & valid) <= above)) {
-            return key[i];
+        for (i = 0; i + 1u < n && !rank_is_avx2(v, 2u, key[i], valid, k, above); i++) {
+        }
+    } else {
+        v[2] = rank_lanes_avx2(key, n, 2u);
+        v[3] = rank_lanes_avx2(key, n, 3u);
+        if (*at < n && rank_is_avx2(v, 4u, key[*at], valid, k, above)) {
+            return key[*at];
+        }
+        for (i = 0; i + 1u < n && !rank_is_avx2(v, 4u, key[i], valid, k, above); i++) {
         }
     }
-    return key[n - 1u];
+    *at = i; /* the last when no earlier key has rank k */
+    return key[i];
 }
 #endif
 
 /* The k-th smallest of n float bit patterns (non-negative floats order like their
  * bits; key may be reordered): Wirth's selection, partitions about the k-th slot until
- * it holds the key a sort would put there. The same float as sorting. */
-static float select_key(uint32_t *key, uint32_t n, uint32_t k)
+ * it holds the key a sort would put there. The same float as sorting. *at: the rank
+ * selection's hint (select_rank_avx2). */
+static float select_key(uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
 {
     int32_t l = 0, r = (int32_t)n - 1, kk = (int32_t)k; /* n <= GS_FIT_CACHE */
     float v;
+    (void)at;
 #if GS_FIT_AVX2
     if (n <= 32u && n > 0u && fit_avx2()) {
         /* a short window's median: the partitions' branches would go either way at random */
-        uint32_t b = select_rank_avx2(key, n, k);
+        uint32_t b = select_rank_avx2(key, n, k, at);
         memcpy(&v, &b, sizeof v);
         return v;
     }
@@ -648,12 +658,13 @@ GS_AVX2 static uint32_t near_keys_avx2(const uint32_t *key, uint32_t *buf, uint3
  * to buf, the ones below are counted; when the k-th lies among them it is selected from
  * those few (every key below ranks before them, every key above after), else from all.
  * The same key either way. */
-static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, float hint_key)
+static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, float hint_key, uint32_t *at)
 {
+    uint32_t none = UINT32_MAX; /* no hint for the few gathered keys */
     float lo = hint_key * 0.75f, hi = hint_key * 1.25f;
     uint32_t lo_b, hi_b, below = 0, m = 0, i;
     if (n < 16u || !(hint_key > 0.0f) || !(hi < (float)INFINITY)) { /* (few keys: the pass costs what it saves) */
-        return select_key(key, n, k);
+        return select_key(key, n, k, at);
     }
     memcpy(&lo_b, &lo, sizeof lo_b);
     memcpy(&hi_b, &hi, sizeof hi_b);
@@ -670,9 +681,9 @@ static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, f
         m += (uint32_t)(x - lo_b < hi_b - lo_b); /* lo_b <= x < hi_b (below lo_b wraps high) */
     }
     if (below <= k && k < below + m) {
-        return select_key(buf, m, k - below);
+        return select_key(buf, m, k - below, &none);
     }
-    return select_key(key, n, k);
+    return select_key(key, n, k, at);
 }
 #endif
 
@@ -941,7 +952,7 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 memcpy(&wn->key[n++], &f, sizeof f);
             }
         }
-        v = select_near(wn->key, wn->key + GS_FIT_CACHE, n, (n - 1) / 2, *wn->med_key);
+        v = select_near(wn->key, wn->key + GS_FIT_CACHE, n, (n - 1) / 2, *wn->med_key, wn->med_at);
         *wn->med_key = v;
         return sqrt((gs_real)v);
     }
@@ -974,7 +985,8 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
             }
         }
         if (collect) {
-            return sqrt((gs_real)select_key(wn->key, n, k));
+            uint32_t none = UINT32_MAX;
+            return sqrt((gs_real)select_key(wn->key, n, k, &none));
         }
         while (d < 15u && k >= cnt[d]) {
             k -= cnt[d];
@@ -1830,6 +1842,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     uint32_t key[GS_FIT_FAST ? 2u * GS_FIT_CACHE : 1u]; /* the keys, and select_near's few */
 #if GS_FIT_FAST
     float med_key = 0.0f;
+    uint32_t med_at = 0;
     gs_real soa[GS_REAL_IS_FLOAT ? 1u : 4u * GS_FIT_CACHE];
     gs_real exy[2u * GS_FIT_CACHE];
     gs_wlast last;
@@ -1842,6 +1855,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     wn.key = key;
 #if GS_FIT_FAST
     wn.med_key = &med_key;
+    wn.med_at = &med_at;
     wn.soa = soa;
     wn.exy = exy;
     wn.last = &last;
