@@ -9,6 +9,7 @@
 #define AHEAD_SLOTS 8
 #define AHEAD_REFILL 4 /* a reader that found every slot full waits until this many are free: one wake per 4 batches */
 #define AHEAD_BATCH_FRAMES 256 /* ~100 kB a slot: a few ms of reading, well inside the caches' reach */
+#define AHEAD_FIRST_FRAMES 16  /* the first batch, short: the core waits for it */
 
 typedef struct {
     gs_kpframe f[AHEAD_BATCH_FRAMES];
@@ -37,6 +38,7 @@ struct kp_ahead {
 static void *reader_main(void *arg)
 {
     kp_ahead *q = arg;
+    uint32_t batch = AHEAD_FIRST_FRAMES;
     for (unsigned w = 0;; w = (w + 1) % AHEAD_SLOTS) {
         pthread_mutex_lock(&q->mu);
         if (q->filled == AHEAD_SLOTS)
@@ -49,7 +51,7 @@ static void *reader_main(void *arg)
         ahead_slot *s = &q->slot[w];
         s->n = 0;
         s->end = GS_KPR_FRAME;
-        while (s->n < AHEAD_BATCH_FRAMES) {
+        while (s->n < batch) {
             gs_kpr_status ks = gs_kpread_next(q->r, &s->f[s->n], &s->err);
             if (ks != GS_KPR_FRAME) {
                 s->end = ks;
@@ -59,6 +61,7 @@ static void *reader_main(void *arg)
                 s->com[s->n].st = gs_pipeline_com(q->com_of, s->f[s->n].kp, &s->com[s->n].out);
             s->n++;
         }
+        batch = AHEAD_BATCH_FRAMES;
         gs_kpread_progress(q->r, &s->done_bytes, &s->total_bytes);
         pthread_mutex_lock(&q->mu);
         q->filled++;

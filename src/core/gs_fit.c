@@ -74,9 +74,24 @@ static const gs_real rad_to_deg = GS_R(57.29577951308232);
 /* An empty fit at a valid centre and scale (> 0 us): all sums and R zero (all-zero bits are +0.0). */
 static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
 {
+#if GS_FIT_FAST
+    /* field by field: a few vector stores where the memset of the whole is a rep stos */
+    int k;
+    for (k = 0; k < 6; k++) {
+        f->r[k] = GS_R(0.0);
+    }
+    for (k = 0; k < 3; k++) {
+        f->zx[k] = f->zy[k] = GS_R(0.0);
+    }
+    f->ssr_x = f->ssr_y = f->sum_w = GS_R(0.0);
+    f->n = 0;
+    f->t0_us = t0_us;
+    f->tscale_s = gs_time_span_s(tscale_us, 0);
+#else
     memset(f, 0, sizeof *f);
     f->t0_us = t0_us;
     f->tscale_s = gs_time_span_s(tscale_us, 0);
+#endif
 }
 
 void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
@@ -331,6 +346,7 @@ typedef struct {
     gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
     uint32_t *key;            /* the median's selection scratch */
     float *med_key;           /* fast builds: the last median's squared residual, as a float */
+    uint32_t *med_at;         /* fast builds: and its index among the keys */
     gs_real *soa;             /* fast double builds: the usable cached samples' tau, x, y, w (4 rows of m) */
     struct gs_wlast *last;    /* fast builds: the last reweighting's sums, solved in full only at the end */
 } gs_win;
@@ -357,6 +373,52 @@ static uint32_t rand_below(uint32_t *state, uint32_t n)
 {
     return xorshift32(state) % n;
 }
+
+#if GS_FIT_FAST && defined(__SIZEOF_INT128__)
+#define GS_FIT_LMS_TABLE 1
+/* The LMS start's GS_FIT_TRIPLES * 3 draws, xorshift32 from GS_FIT_SEED_IRLS in order:
+ * the same numbers without the generator's dependent shifts */
+static const uint32_t lms_draws[3u * GS_FIT_TRIPLES] = {
+    0x510C4619u, 0xE02E553Eu, 0x7BB98F3Au, 0x0183A8B5u, 0xE6336D1Fu, 0xF989D237u,
+    0xBA2529D0u, 0xFCFBEDBFu, 0xA8C5EE39u, 0xB55A53B8u, 0x1A88A9EEu, 0xF918A8B4u,
+    0x6DC588D3u, 0x472F513Cu, 0x0C1870B8u, 0x43E1465Fu, 0x0E78EA8Au, 0x761DC0DEu,
+    0x0ECA9C7Du, 0xF5E7493Fu, 0x84D44CBFu, 0xA536E9DEu, 0x79AFAED8u, 0x02E9F4A2u,
+    0xB3C8F91Cu, 0x318EC249u, 0xD13543EAu, 0x504FD68Eu, 0xF9563BE1u, 0xFB6A9A74u,
+    0xACAD82A6u, 0x83D0D79Au, 0xBD58BA6Bu, 0xE8A46341u, 0xFD4255C7u, 0x48A7297Au,
+    0x1C8FC87Eu, 0x558F2D7Eu, 0xB43618AEu, 0x935F84DFu, 0x1B4EF29Du, 0x66BB3273u,
+    0x1E5F1329u, 0x7B73EBB4u, 0xC6A87E76u, 0xE5BD8265u, 0xEBD01B3Du, 0xFE4E23A6u,
+    0x7D6529DBu, 0xD39A9B74u, 0x9E7F3ACEu, 0x5DFE0DFDu, 0x147D987Du, 0x493F1344u,
+    0xC1AF1B0Fu, 0x7B13A768u, 0xF02AB277u, 0x6AE429E5u, 0x14C73F29u, 0x976EB1B8u,
+    0x6A6BB394u, 0x9F3E8E98u, 0x9358942Eu, 0xBA7F8CC0u, 0x37128F53u, 0xB9E359CFu,
+    0x8980C4E2u, 0xB28541ECu, 0x4DA15AB0u, 0xB81A50ABu, 0xB3E67C2Cu, 0xF01B81BDu,
+    0x85A054CBu, 0x681719B7u, 0xEF1638C7u, 0x29D754C0u, 0xAAA99987u, 0xAABF9C2Bu,
+    0x7E60C676u, 0xB3689101u, 0x8854D505u, 0x4C7BF39Fu, 0x730959FBu, 0x5EF4A9E0u,
+    0xB2D14C84u, 0xF371A5A4u, 0x3F6D8E86u, 0x591C32D8u, 0x37ACF21Bu, 0x94171B6Cu,
+    0x982EBAF1u, 0xA1671469u, 0x3EA8A61Cu, 0x670D5609u, 0x744E0D0Fu, 0x081948F8u,
+    0x01CD571Bu, 0xCEE2330Cu, 0x98FD1EEDu, 0x5F34CCDDu, 0x134EFECAu, 0x5E6CC8A1u,
+    0x2869E8BDu, 0xBAB60242u, 0x2531989Du, 0xD264420Cu, 0x1E980CDEu, 0xFF7BA8BFu,
+    0xC7EDBCA9u, 0x7F6C3635u, 0xCCF7B6E0u, 0x7F5ED555u, 0x1B70D24Fu, 0x261F68B3u,
+    0xAA24CBD7u, 0x58987D78u, 0xB1DD8A83u, 0x1130B265u, 0xE8FE2ABBu, 0x9882D18Fu,
+    0x94D94A16u, 0x0EE14FBBu, 0xC5D1BA30u, 0xA06FAC1Bu, 0xE8703B4Du, 0x0C2474E1u,
+    0xD5BAA21Du, 0xBED11EC1u, 0x3C2778E5u, 0xB44D9E78u, 0xF7D12A99u, 0x82CE18D8u,
+    0x7B723E72u, 0xAB3065ACu, 0x57337BAEu, 0x3092562Du, 0x30AEABC6u, 0x5F153C8Du,
+    0xE818F92Fu, 0x10913491u, 0xF662FD90u, 0x93C58678u, 0x4258685Du, 0xA52E1174u,
+    0x8714FC74u, 0x0BD47719u, 0x23D5A5C2u, 0x7AD860F4u, 0xAE1DA977u, 0x7D5BD92Eu,
+    0xC9BD5831u, 0x35D264ECu, 0x50B4D12Bu, 0x98AB5803u, 0x86C37B16u, 0xDD983706u,
+    0xB46BCDFAu, 0x77498910u, 0x8B1EEE85u, 0x8F02D9A2u, 0x52E88499u, 0x0D0B3124u,
+    0x0EDF12D3u, 0x7C2596B1u, 0x1089E8C8u, 0x9F8F3E00u, 0x71AF46C7u, 0xB78AA5FCu,
+    0x859FD8A6u, 0xAFEFDB83u, 0xC76DA84Cu, 0x3EE63EBEu, 0xDF01C6E6u, 0x1C73D408u,
+    0xB8AE0951u, 0x4906A7F3u, 0x22E9A8EFu, 0xE97C21B5u, 0xC41C5510u, 0x99703BAFu,
+};
+
+/* a % n through n's 64-bit reciprocal magic = UINT64_MAX / n + 1 (exact for every 32-bit a, n >= 1) */
+static inline uint32_t mod_by(uint32_t a, uint64_t magic, uint32_t n)
+{
+    return (uint32_t)(((unsigned __int128)(magic * a) * n) >> 64);
+}
+#else
+#define GS_FIT_LMS_TABLE 0
+#endif
 
 /* A held sample with a weight and a position takes part in the fits. */
 static bool sample_usable(const gs_sample *s)
@@ -459,13 +521,83 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
     return true;
 }
 
+#if GS_FIT_AVX2
+/* Keys [8j, 8j+8) of n, unsigned order made signed; lanes past n read as 0. */
+GS_AVX2 static inline __m256i rank_lanes_avx2(const uint32_t *key, uint32_t n, uint32_t j)
+{
+    uint32_t left = n > 8u * j ? n - 8u * j : 0u;
+    __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)left), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    return _mm256_xor_si256(_mm256_maskload_epi32((const int *)(const void *)&key[8u * j], lanes),
+                            _mm256_set1_epi32(INT32_MIN));
+}
+
+/* Lanes of v below x, and above x, as bits 8j.. of *lt, *gt. */
+GS_AVX2 static inline void rank_bits_avx2(__m256i x, __m256i v, uint32_t j, uint32_t *lt, uint32_t *gt)
+{
+    *lt |= (uint32_t)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(x, v))) << (8u * j);
+    *gt |= (uint32_t)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(v, x))) << (8u * j);
+}
+
+/* Key x ranks k among the keys in v[0..nv) (valid: their lanes): at most k keys lie
+ * below it and at most above = n - 1 - k above it. */
+GS_AVX2 static inline bool rank_is_avx2(const __m256i *v, uint32_t nv, uint32_t x_key, uint32_t valid, uint32_t k,
+                                        uint32_t above)
+{
+    __m256i x = _mm256_set1_epi32((int)(x_key ^ 0x80000000u));
+    uint32_t lt = 0, gt = 0, j;
+    for (j = 0; j < nv; j++) {
+        rank_bits_avx2(x, v[j], j, &lt, &gt);
+    }
+    return ((uint32_t)__builtin_popcount(lt & valid) <= k) & ((uint32_t)__builtin_popcount(gt & valid) <= above);
+}
+
+/* The k-th smallest of n <= 32 keys (k < n) by rank, without data-dependent branches
+ * but the one that finds it (unsigned order, as select_key's). *at: where to look
+ * first (the last median's index: an IRLS step's median is mostly the same sample's),
+ * then where it was found. */
+GS_AVX2 static uint32_t select_rank_avx2(const uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
+{
+    uint32_t valid = n == 32u ? ~0u : (1u << n) - 1u, above = n - 1u - k, i;
+    __m256i v[4];
+    v[0] = rank_lanes_avx2(key, n, 0u);
+    v[1] = rank_lanes_avx2(key, n, 1u);
+    if (n <= 16u) {
+        if (*at < n && rank_is_avx2(v, 2u, key[*at], valid, k, above)) {
+            return key[*at];
+        }
+        for (i = 0; i + 1u < n && !rank_is_avx2(v, 2u, key[i], valid, k, above); i++) {
+        }
+    } else {
+        v[2] = rank_lanes_avx2(key, n, 2u);
+        v[3] = rank_lanes_avx2(key, n, 3u);
+        if (*at < n && rank_is_avx2(v, 4u, key[*at], valid, k, above)) {
+            return key[*at];
+        }
+        for (i = 0; i + 1u < n && !rank_is_avx2(v, 4u, key[i], valid, k, above); i++) {
+        }
+    }
+    *at = i; /* the last when no earlier key has rank k */
+    return key[i];
+}
+#endif
+
 /* The k-th smallest of n float bit patterns (non-negative floats order like their
- * bits; key is reordered): Wirth's selection, partitions about the k-th slot until
- * it holds the key a sort would put there. The same float as sorting. */
-static float select_key(uint32_t *key, uint32_t n, uint32_t k)
+ * bits; key may be reordered): Wirth's selection, partitions about the k-th slot until
+ * it holds the key a sort would put there. The same float as sorting. *at: the rank
+ * selection's hint (select_rank_avx2). */
+static float select_key(uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
 {
     int32_t l = 0, r = (int32_t)n - 1, kk = (int32_t)k; /* n <= GS_FIT_CACHE */
     float v;
+    (void)at;
+#if GS_FIT_AVX2
+    if (n <= 32u && n > 0u && fit_avx2()) {
+        /* a short window's median: the partitions' branches would go either way at random */
+        uint32_t b = select_rank_avx2(key, n, k, at);
+        memcpy(&v, &b, sizeof v);
+        return v;
+    }
+#endif
     while (l < r) {
         uint32_t x = key[kk];
         int32_t i = l, j = r;
@@ -526,12 +658,13 @@ GS_AVX2 static uint32_t near_keys_avx2(const uint32_t *key, uint32_t *buf, uint3
  * to buf, the ones below are counted; when the k-th lies among them it is selected from
  * those few (every key below ranks before them, every key above after), else from all.
  * The same key either way. */
-static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, float hint_key)
+static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, float hint_key, uint32_t *at)
 {
+    uint32_t none = UINT32_MAX; /* no hint for the few gathered keys */
     float lo = hint_key * 0.75f, hi = hint_key * 1.25f;
     uint32_t lo_b, hi_b, below = 0, m = 0, i;
     if (n < 16u || !(hint_key > 0.0f) || !(hi < (float)INFINITY)) { /* (few keys: the pass costs what it saves) */
-        return select_key(key, n, k);
+        return select_key(key, n, k, at);
     }
     memcpy(&lo_b, &lo, sizeof lo_b);
     memcpy(&hi_b, &hi, sizeof hi_b);
@@ -548,9 +681,9 @@ static float select_near(uint32_t *key, uint32_t *buf, uint32_t n, uint32_t k, f
         m += (uint32_t)(x - lo_b < hi_b - lo_b); /* lo_b <= x < hi_b (below lo_b wraps high) */
     }
     if (below <= k && k < below + m) {
-        return select_key(buf, m, k - below);
+        return select_key(buf, m, k - below, &none);
     }
-    return select_key(key, n, k);
+    return select_key(key, n, k, at);
 }
 #endif
 
@@ -819,7 +952,7 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
                 memcpy(&wn->key[n++], &f, sizeof f);
             }
         }
-        v = select_near(wn->key, wn->key + GS_FIT_CACHE, n, (n - 1) / 2, *wn->med_key);
+        v = select_near(wn->key, wn->key + GS_FIT_CACHE, n, (n - 1) / 2, *wn->med_key, wn->med_at);
         *wn->med_key = v;
         return sqrt((gs_real)v);
     }
@@ -852,7 +985,8 @@ static gs_real median_resid(const gs_win *wn, const gs_par *p)
             }
         }
         if (collect) {
-            return sqrt((gs_real)select_key(wn->key, n, k));
+            uint32_t none = UINT32_MAX;
+            return sqrt((gs_real)select_key(wn->key, n, k, &none));
         }
         while (d < 15u && k >= cnt[d]) {
             k -= cnt[d];
@@ -919,13 +1053,13 @@ static double below_key(float key)
 /* median_below over a window the cache holds, in double: sqrt((double)a) < sqrt((double)b)
  * exactly when a < b for floats a, b >= 0 (adjacent floats differ by far more than a
  * double's rounding), so each squared residual's float is compared with the median's
- * (through below_key, without the conversion). The usable samples in rows, two at a time
+ * through T = below_key(the median's float), which the caller takes once per best
+ * median (without the conversion). The usable samples in rows, two at a time
  * where the compiler has vectors; the decision only counts, in any order. */
-static bool median_below_cached(const gs_win *wn, const gs_par *p, float med_key)
+static bool median_below_cached(const gs_win *wn, const gs_par *p, double T)
 {
     const gs_real *t = wn->soa, *x = wn->soa + GS_FIT_CACHE, *y = wn->soa + 2u * GS_FIT_CACHE;
     gs_real c0 = p->c[0], c1 = p->c[1], c2 = p->c[2], c3 = p->c[3], c4 = p->c[4], c5 = p->c[5];
-    double T = below_key(med_key);
     uint32_t m = wn->m, need = (m - 1) / 2 + 1, room = m - need, less = 0, j = 0;
 #if GS_FIT_AVX2
     if (fit_avx2()) {
@@ -1265,15 +1399,18 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     gs_wsums a;
     gs_par base;
     uint32_t i;
-    memset(&a, 0, sizeof a);
+#if GS_FIT_FAST
+    base = model && !GS_REAL_IS_FLOAT ? *model : (gs_par){{0}};
+#else
     memset(&base, 0, sizeof base);
     if (model && !GS_REAL_IS_FLOAT) {
         base = *model;
     }
+#endif
     fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
 #if GS_FIT_FAST
     if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE) {
-        wsums_cached(wn, model, &base, mode, cut, keep, r2, &a);
+        wsums_cached(wn, model, &base, mode, cut, keep, r2, &a); /* sets every sum */
         wsums_to_fit(&a, &f);
         if (!out) {
             /* an IRLS step: the curve now, the result from the kept sums when the run ends */
@@ -1285,6 +1422,7 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
         return solve_par(&f, out, p, &base);
     }
 #endif
+    memset(&a, 0, sizeof a);
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
@@ -1358,21 +1496,35 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     uint32_t third = m / 3, k;
     bool found = false;
 #if GS_FIT_FAST
-    float best_key = 0.0f; /* *best_med's squared residual as a float, once found */
+    double best_T = 0.0; /* below_key of *best_med's squared residual as a float, once found */
     /* a short window draws the same triple again and again: its curve, median and
      * verdict are the ones already had, so it is skipped (a bit per possible triple) */
     uint32_t span_c = m - 2 * third, n_triples = third * third * span_c;
     uint32_t seen[GS_FIT_SEEN_BITS / 32u];
     bool dedup = n_triples <= GS_FIT_SEEN_BITS;
-    if (dedup) {
+    if (n_triples <= 256u) {
+        memset(seen, 0, 8u * sizeof seen[0]); /* short windows: two stores, not a rep stos */
+    } else if (dedup) {
         memset(seen, 0, ((n_triples + 31u) / 32u) * sizeof seen[0]);
     }
 #endif
+    /* par_through_usable's common case, decided once */
+    bool all_cached = GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE;
+#if GS_FIT_LMS_TABLE
+    uint64_t magic_ab = UINT64_MAX / third + 1u, magic_c = UINT64_MAX / (m - 2 * third) + 1u;
+    (void)state;
+#endif
     *best_med = (gs_real)INFINITY;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
+#if GS_FIT_LMS_TABLE
+        uint32_t ka = mod_by(lms_draws[3u * k], magic_ab, third);
+        uint32_t kb = third + mod_by(lms_draws[3u * k + 1u], magic_ab, third);
+        uint32_t kc = 2 * third + mod_by(lms_draws[3u * k + 2u], magic_c, m - 2 * third);
+#else
         uint32_t ka = rand_below(&state, third);
         uint32_t kb = third + rand_below(&state, third);
         uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
+#endif
         gs_par p;
         gs_real med;
 #if GS_FIT_FAST
@@ -1384,11 +1536,12 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
             seen[t >> 5] |= 1u << (t & 31u);
         }
 #endif
-        if (!par_through_usable(wn, ka, kb, kc, &p)) {
+        if (!(all_cached ? par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], &p)
+                         : par_through_usable(wn, ka, kb, kc, &p))) {
             continue;
         }
 #if GS_FIT_FAST
-        if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_key)
+        if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_T)
                                                                        : !median_below(wn, &p, *best_med))) {
             continue; /* cannot win: no median needed (m > 3 here: m = 3 stops at the first) */
         }
@@ -1399,7 +1552,7 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
             *best = p;
             found = true;
 #if GS_FIT_FAST
-            best_key = *wn->med_key;
+            best_T = below_key(*wn->med_key);
 #endif
         }
         if (m == 3) {
@@ -1689,6 +1842,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     uint32_t key[GS_FIT_FAST ? 2u * GS_FIT_CACHE : 1u]; /* the keys, and select_near's few */
 #if GS_FIT_FAST
     float med_key = 0.0f;
+    uint32_t med_at = 0;
     gs_real soa[GS_REAL_IS_FLOAT ? 1u : 4u * GS_FIT_CACHE];
     gs_real exy[2u * GS_FIT_CACHE];
     gs_wlast last;
@@ -1701,6 +1855,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     wn.key = key;
 #if GS_FIT_FAST
     wn.med_key = &med_key;
+    wn.med_at = &med_at;
     wn.soa = soa;
     wn.exy = exy;
     wn.last = &last;

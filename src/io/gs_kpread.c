@@ -15,7 +15,8 @@
 #include "gravscale/gs_num.h"
 #include "gs_fastnum.h"
 
-#define CSV_BLOCK (1u << 20)          /* fread block; also the longest line accepted */
+#define CSV_BLOCK (1u << 20)          /* the read buffer: the longest line accepted */
+#define CSV_READ (1u << 16)           /* bytes asked of one fread: the buffer's first pages stay in use and in cache */
 #define CSV_MAX_COLS (2 + 3 * GS_KP_MAX + 1)
 #define PEOPLE_FIRST_FRAMES 30        /* frames with people that decide the followed track */
 
@@ -163,7 +164,8 @@ static int csv_getline(gs_kpread *r, const char **s, size_t *n, bool *had_nl, gs
                            "line longer than %u bytes", (unsigned)CSV_BLOCK);
             return -1;
         }
-        size_t got = fread(r->buf + r->len, 1, CSV_BLOCK - r->len, r->f);
+        size_t ask = CSV_BLOCK - r->len < CSV_READ ? CSV_BLOCK - r->len : CSV_READ;
+        size_t got = fread(r->buf + r->len, 1, ask, r->f);
         r->len += got;
         r->buf[r->len] = '\0'; /* the sentinel the number scans stop at */
         r->done_bytes += got;
