@@ -4,7 +4,8 @@
 // a_px = g / q. Checks the diameter (2 %) and q of each flight for FFV1 and
 // MJPG clips and an image sequence; a slow-motion clip stored at a false rate
 // (--fps and the com.android.capture.fps tag, written here with libavformat);
-// the H.264 end-of-stream timestamps; corrupt, empty, truncated and missing
+// the H.264 end-of-stream timestamps; the frame source's own H.264 decoding
+// against OpenCV's, pixel for pixel and time for time; corrupt, empty, truncated and missing
 // files; a clip without a ball; the overlay and the plot.
 #include <cerrno>
 #include <cmath>
@@ -318,6 +319,77 @@ static void test_h264_drained_frames_get_increasing_times(void)
     check_ball_run(run({p}), s, 0.02);
 }
 
+// A textured H.264 clip (B-frames, every pixel's colour moving) of the given width.
+static bool write_textured_h264(const std::string &path, int width, int height, int frames)
+{
+    cv::VideoWriter w(path, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 30.0,
+                      cv::Size(width, height), true);
+    if (!w.isOpened()) return false;
+    cv::Mat base(height, width, CV_8UC3);
+    cv::RNG rng(7);
+    rng.fill(base, cv::RNG::UNIFORM, 0, 256);
+    cv::GaussianBlur(base, base, cv::Size(0, 0), 2.0);
+    for (int i = 0; i < frames; i++) {
+        cv::Mat f;
+        cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 1.5 * i, 0, 1, 0.5 * i);
+        cv::warpAffine(base, f, shift, base.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+        cv::circle(f, cv::Point(width / 4 + 3 * i, height / 2), height / 6, cv::Scalar(30, 140, 250), -1);
+        w.write(f);
+    }
+    w.release();
+    return true;
+}
+
+// Every frame and time of cv::VideoCapture: the same pixels, the same stream times
+// (repaired where OpenCV's do not increase), the same number of frames, whichever
+// decoder the frame source took and with any number of decoding threads.
+static void check_same_as_opencv(const std::string &path, int threads, const char *decoder)
+{
+    gs::FrameSourceOptions fo;
+    fo.decode_threads = threads;
+    std::string err;
+    gs::FrameSource::Error kind;
+    auto src = gs::FrameSource::open(path, fo, err, kind);
+    TEST_ASSERT_NOT_NULL_MESSAGE(src.get(), err.c_str());
+    TEST_ASSERT_EQUAL_STRING(decoder, src->decoder());
+    cv::VideoCapture cap(path, cv::CAP_FFMPEG);
+    TEST_ASSERT_TRUE(cap.isOpened());
+    gs::Frame f;
+    cv::Mat ref;
+    int n = 0, repaired = 0;
+    double last_ms = -1e300;
+    while (src->next(f)) {
+        TEST_ASSERT_TRUE_MESSAGE(cap.read(ref) && !ref.empty(), "the frame source gave more frames than OpenCV");
+        double ms = cap.get(cv::CAP_PROP_POS_MSEC);
+        TEST_ASSERT_EQUAL_INT(ref.rows, f.bgr.rows);
+        TEST_ASSERT_EQUAL_INT(ref.cols, f.bgr.cols);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(0, cv::norm(ref, f.bgr, cv::NORM_INF), "a pixel differs from OpenCV's");
+        if (n == 0 || ms * 1e-3 > last_ms * 1e-3) {
+            TEST_ASSERT_FALSE(f.t_repaired);
+            TEST_ASSERT_EQUAL_DOUBLE(ms * 1e-3, f.t_stream_s);
+        } else {
+            TEST_ASSERT_TRUE(f.t_repaired);
+            repaired++;
+        }
+        if (!f.t_repaired) last_ms = ms;
+        n++;
+    }
+    TEST_ASSERT_FALSE_MESSAGE(cap.read(ref), "OpenCV gave more frames than the frame source");
+    TEST_ASSERT_TRUE(n > 0);
+    TEST_ASSERT_EQUAL_INT(repaired, static_cast<int>(src->times_repaired()));
+}
+
+static void test_frame_source_same_as_opencv(void)
+{
+    std::string direct = tmp("textured_640.mp4"), odd = tmp("textured_324.mp4");
+    if (!write_textured_h264(direct, 640, 360, 40) || !write_textured_h264(odd, 324, 240, 20))
+        TEST_IGNORE_MESSAGE("this FFmpeg cannot write H.264");
+    check_same_as_opencv(direct, 1, "libavcodec");
+    check_same_as_opencv(direct, 0, "libavcodec");
+    check_same_as_opencv(odd, 1, "opencv");  // a width of 8-pixel blocks and a half: OpenCV's own path
+    check_same_as_opencv(g_ffv1, 0, "opencv");  // not 4:2:0
+}
+
 static Scene slowmo_scene(void)
 {
     Scene s;
@@ -568,6 +640,7 @@ int main(void)
     RUN_TEST(test_nmea_output);
     RUN_TEST(test_frame_source_ffv1_times_exact);
     RUN_TEST(test_h264_drained_frames_get_increasing_times);
+    RUN_TEST(test_frame_source_same_as_opencv);
     RUN_TEST(test_false_frame_rate_cli);
     RUN_TEST(test_false_frame_rate_metadata);
     RUN_TEST(test_image_sequence);

@@ -10,7 +10,7 @@ BUILD_DIR=${BUILD_DIR:-build}
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 
-# OpenCV and libavformat for the video command (tests render clips with them);
+# OpenCV and FFmpeg's libavformat, libavcodec and libswscale for the video command (tests render clips with them);
 # python3-opencv, python3-venv and opencv-doc for the pose models' converter and its test;
 # Eigen for the ball detector's ballistic fits (and the tests' batch references);
 # clang with its sanitizer/libFuzzer runtime and llvm-symbolizer for tests/fuzz/run.sh;
@@ -19,7 +19,7 @@ SUDO=""
 # the kiosk (docs/kiosk.md): civetweb for its page, SQLite for the history, nlohmann-json;
 # libmosquitto for the MQTT sink and the mosquitto broker (and its clients) its tests start;
 # chromium and chromedriver for the kiosk's browser test (about 13 s to install here)
-pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev
+pkgs=(build-essential cmake ninja-build python3 binutils pkg-config libopencv-dev libavformat-dev libavcodec-dev libswscale-dev
       python3-opencv python3-venv opencv-doc libeigen3-dev
       clang libclang-rt-14-dev llvm-14
       gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm

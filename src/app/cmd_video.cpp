@@ -537,6 +537,7 @@ struct LoopTimes {
     int64_t frames = 0, detector_runs = 0;
 
     const char *engine = "none";  // the pose networks' engine
+    const char *decoder = "none";  // the frame source's decoder
 
     void write(const char *path, int prefetch, double end_ms, double end_cpu_ms) const
     {
@@ -546,9 +547,9 @@ struct LoopTimes {
             std::fprintf(f, ",\"%s_ms\":%.3f", name, frames ? c.wall_ms / frames : 0.0);
             if (&c != &network) std::fprintf(f, ",\"%s_cpu_ms\":%.3f", name, frames ? c.cpu_ms / frames : 0.0);
         };
-        std::fprintf(f, "{\"engine\":\"%s\",\"frames\":%lld,\"prefetch\":%d,\"cv_threads\":%d,\"setup_s\":%.4f,\"loop_s\":%.4f,"
+        std::fprintf(f, "{\"engine\":\"%s\",\"decoder\":\"%s\",\"frames\":%lld,\"prefetch\":%d,\"cv_threads\":%d,\"setup_s\":%.4f,\"loop_s\":%.4f,"
                         "\"total_s\":%.4f,\"setup_cpu_s\":%.4f,\"loop_cpu_s\":%.4f,\"detector_runs\":%lld",
-                     engine, static_cast<long long>(frames), prefetch, cv::getNumThreads(), (loop0_ms - t0_ms) / 1e3,
+                     engine, decoder, static_cast<long long>(frames), prefetch, cv::getNumThreads(), (loop0_ms - t0_ms) / 1e3,
                      (end_ms - loop0_ms) / 1e3, (end_ms - t0_ms) / 1e3, (loop_cpu0_ms - cpu0_ms) / 1e3,
                      (end_cpu_ms - loop_cpu0_ms) / 1e3, static_cast<long long>(detector_runs));
         per(decode, "decode");
@@ -606,6 +607,8 @@ int run(const Options &o)
 
     gs::FrameSourceOptions fo;
     fo.fps = o.fps;
+    // prefetching gives decoding a thread of its own: one decoder thread, the least CPU a frame
+    if (person && o.prefetch > 0) fo.decode_threads = 1;
     std::string err;
     gs::FrameSource::Error kind;
     std::unique_ptr<gs::FrameSource> src = gs::FrameSource::open(o.input, fo, err, kind);
@@ -613,6 +616,7 @@ int run(const Options &o)
         std::fprintf(stderr, "gravscale: %s: %s\n", o.input.c_str(), err.c_str());
         return kind == gs::FrameSource::Error::usage ? EXIT_USAGE : EXIT_DATA;
     }
+    times.decoder = src->decoder();
 
     App app;
     app.fmt = o.out_format_set ? o.out_format : cfg.format;

@@ -614,8 +614,8 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
         for (const cv::Point2f &p : pts_)
             if (!inside_any(ex, p)) from.push_back(p);
         std::vector<uchar> st;
-        std::vector<float> err;
-        if (!from.empty()) cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, from, next, st, err, win, levels);
+        // no error output: OpenCV would sample every window once more for it
+        if (!from.empty()) cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, from, next, st, cv::noArray(), win, levels);
         std::vector<cv::Point2f> a, b;
         for (size_t i = 0; i < from.size(); i++)
             if (st[i] && !inside_any(ex, next[i])) {
@@ -718,8 +718,7 @@ int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vecto
     if (p0.empty()) return 0;
     for (cv::Point2f &p : p0) p = cv::Point2f(2.0f * p.x + 0.5f + (float)box.x, 2.0f * p.y + 0.5f + (float)box.y);
     std::vector<uchar> st;
-    std::vector<float> err;
-    cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, p0, p1, st, err, cv::Size(21, 21), 3);  // both pyramids built once
+    cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, p0, p1, st, cv::noArray(), cv::Size(21, 21), 3);  // both pyramids built once
     const double thr = cfg_.other_px * scale_;
     int n = 0;
     for (size_t i = 0; i < p0.size(); i++) {

@@ -1,5 +1,7 @@
-// frame_source.cpp - video files through OpenCV's FFmpeg backend (timestamps,
-// repaired) and libavformat (container rate, capture-fps tag); image sequences.
+// frame_source.cpp - video files decoded by libavcodec into the frame's own
+// buffer (OpenCV's FFmpeg backend for what that path does not reproduce:
+// rotated streams, other pixel formats), the stream's times repaired, the
+// container's rate and capture-fps tag from libavformat; image sequences.
 #include "frame_source.hpp"
 
 #include <algorithm>
@@ -19,8 +21,10 @@ extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
 #include <libavutil/dict.h>
+#include <libavutil/display.h>
 #include <libavutil/error.h>
 #include <libavutil/log.h>
+#include <libswscale/swscale.h>
 }
 
 namespace fs = std::filesystem;
@@ -105,17 +109,130 @@ double median(std::vector<double> v)
 
 // ---- video file -------------------------------------------------------------
 
+// libavcodec straight into the frame's buffer: the frames and times of
+// cv::VideoCapture (OpenCV 4.6's FFmpeg backend: the packet's decoding time as
+// the frame's, 0 when it has none; BGR by sws_scale with SWS_BICUBIC) without
+// its copy of every frame, with as many decoding threads as asked (1: all in
+// the caller's thread, the least CPU a frame). Only where that is the same
+// path: 4:2:0 pictures of the stream's own size, a width of whole 8-pixel
+// blocks, no rotation to apply; anything else goes through OpenCV.
+class AvDecoder {
+public:
+    ~AvDecoder()
+    {
+        sws_freeContext(sws_);
+        av_packet_free(&pkt_);
+        av_frame_free(&pic_);
+        avcodec_free_context(&ctx_);
+        avformat_close_input(&ic_);
+    }
+
+    // false: this path does not apply (the caller falls back to OpenCV)
+    bool open(const std::string &path, int threads)
+    {
+        if (avformat_open_input(&ic_, path.c_str(), nullptr, nullptr) < 0) return false;
+        if (avformat_find_stream_info(ic_, nullptr) < 0) return false;
+        for (unsigned i = 0; i < ic_->nb_streams && vs_ < 0; i++)
+            if (ic_->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_VIDEO) vs_ = static_cast<int>(i);
+        if (vs_ < 0) return false;
+        AVStream *st = ic_->streams[vs_];
+        const uint8_t *dm = av_stream_get_side_data(st, AV_PKT_DATA_DISPLAYMATRIX, nullptr);
+        if (dm && std::lround(av_display_rotation_get(reinterpret_cast<const int32_t *>(dm))) % 360 != 0)
+            return false;  // OpenCV turns such frames upright
+        const AVCodec *codec = avcodec_find_decoder(st->codecpar->codec_id);
+        if (!codec || !(ctx_ = avcodec_alloc_context3(codec))) return false;
+        ctx_->thread_count = threads;
+        if (avcodec_parameters_to_context(ctx_, st->codecpar) < 0 || avcodec_open2(ctx_, codec, nullptr) < 0)
+            return false;
+        if ((ctx_->pix_fmt != AV_PIX_FMT_YUV420P && ctx_->pix_fmt != AV_PIX_FMT_YUVJ420P) ||
+            ctx_->coded_width != ctx_->width || ctx_->coded_height != ctx_->height || ctx_->width <= 0 ||
+            ctx_->height <= 0 || ctx_->width % 8 != 0)
+            return false;  // sws_scale converts rows in 8-pixel blocks: other widths depend on the row's padding
+        pic_ = av_frame_alloc();
+        pkt_ = av_packet_alloc();
+        return pic_ && pkt_;
+    }
+
+    // the next frame into bgr (its memory reused when it fits) and its time (s); false at the end
+    bool read(cv::Mat &bgr, double &t_s)
+    {
+        const AVStream *st = ic_->streams[vs_];
+        if (st->nb_frames > 0 && n_frames_ > st->nb_frames) return false;
+        bool valid = avcodec_receive_frame(ctx_, pic_) >= 0;
+        for (int errs = 0; !valid;) {
+            av_packet_unref(pkt_);
+            int rc = av_read_frame(ic_, pkt_);
+            if (rc == AVERROR(EAGAIN)) continue;
+            if (rc == AVERROR_EOF) {  // drain the decoder's delayed frames
+                pkt_->data = nullptr;
+                pkt_->size = 0;
+                pkt_->stream_index = vs_;
+            }
+            if (pkt_->stream_index != vs_) {
+                av_packet_unref(pkt_);
+                if (++errs > kMaxErrors) break;
+                continue;
+            }
+            if (avcodec_send_packet(ctx_, pkt_) < 0) break;
+            rc = avcodec_receive_frame(ctx_, pic_);
+            if (rc >= 0)
+                valid = true;
+            else if (rc != AVERROR(EAGAIN) && ++errs > kMaxErrors)
+                break;
+        }
+        if (!valid || pic_->width != ctx_->width || pic_->height != ctx_->height) return false;
+        n_frames_++;
+        const int64_t dts = pic_->pkt_dts;
+        const AVRational tb = st->time_base;
+        const double sec_per_tick = tb.num == 0 || tb.den == 0 ? 0.0 : static_cast<double>(tb.num) / tb.den;
+        // OpenCV's milliseconds, then seconds, in its order of operations
+        const double ms = dts == AV_NOPTS_VALUE ? 0.0
+                                                 : static_cast<double>(static_cast<int64_t>(
+                                                       static_cast<uint64_t>(dts) - static_cast<uint64_t>(st->start_time))) *
+                                                       sec_per_tick * 1000;
+        t_s = ms * 1e-3;
+        sws_ = sws_getCachedContext(sws_, ctx_->width, ctx_->height, static_cast<AVPixelFormat>(pic_->format),
+                                    ctx_->width, ctx_->height, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr,
+                                    nullptr);
+        if (!sws_) return false;
+        bgr.create(ctx_->height, ctx_->width, CV_8UC3);
+        uint8_t *dst[4] = {bgr.data, nullptr, nullptr, nullptr};
+        int dst_step[4] = {static_cast<int>(bgr.step), 0, 0, 0};
+        sws_scale(sws_, pic_->data, pic_->linesize, 0, pic_->height, dst, dst_step);
+        return true;
+    }
+
+private:
+    static constexpr int kMaxErrors = 1 << 9;
+    AVFormatContext *ic_ = nullptr;
+    AVCodecContext *ctx_ = nullptr;
+    AVFrame *pic_ = nullptr;
+    AVPacket *pkt_ = nullptr;
+    SwsContext *sws_ = nullptr;
+    int vs_ = -1;
+    int64_t n_frames_ = 0;
+};
+
 class VideoFileSource : public FrameSource {
 public:
     bool init(const std::string &path, const FrameSourceOptions &opt, std::string &err)
     {
         if (!probe_video(path, probe_, err)) return false;
-        // OpenCV keeps its own FFmpeg state and may reset the log level: quiet it again
-        cap_.open(path, cv::CAP_FFMPEG);
-        av_log_set_level(AV_LOG_QUIET);
-        if (!cap_.isOpened()) {
-            err = "cannot decode the video stream (codec " + probe_.codec + ")";
-            return false;
+        const int threads = opt.decode_threads > 0 ? opt.decode_threads : static_cast<int>(cv::getNumberOfCPUs());
+        std::unique_ptr<AvDecoder> av(new AvDecoder);
+        if (av->open(path, threads)) {
+            av_ = std::move(av);
+            decoder_ = "libavcodec";
+        } else {
+            decoder_ = "opencv";
+            av.reset();
+            // OpenCV keeps its own FFmpeg state and may reset the log level: quiet it again
+            cap_.open(path, cv::CAP_FFMPEG);
+            av_log_set_level(AV_LOG_QUIET);
+            if (!cap_.isOpened()) {
+                err = "cannot decode the video stream (codec " + probe_.codec + ")";
+                return false;
+            }
         }
         size_ = cv::Size(probe_.width, probe_.height);
         if (plausible_fps(probe_.avg_fps)) {
@@ -148,6 +265,7 @@ public:
 protected:
     bool read_raw(cv::Mat &bgr, double &t) override
     {
+        if (av_) return av_->read(bgr, t);
         if (!cap_.read(bgr) || bgr.empty()) return false;
         double ms = cap_.get(cv::CAP_PROP_POS_MSEC);
         t = std::isfinite(ms) ? ms * 1e-3 : NAN;
@@ -155,6 +273,7 @@ protected:
     }
 
 private:
+    std::unique_ptr<AvDecoder> av_;  // else OpenCV's
     cv::VideoCapture cap_;
 };
 

@@ -26,6 +26,7 @@ namespace gs {
 
 struct FrameSourceOptions {
     double fps = 0.0;  // --fps: the true frame rate; 0 = not given
+    int decode_threads = 0;  // a video's decoding threads; 0: one per CPU
 };
 
 // What the probe learns from the container (libavformat), before decoding.
@@ -76,6 +77,7 @@ public:
     int64_t frames_read() const { return n_read_; }
     int64_t times_repaired() const { return n_repaired_; }
     bool is_image_sequence() const { return images_; }
+    const char *decoder() const { return decoder_; }   // "libavcodec", "opencv" or "images"
     cv::Size size() const { return size_; }
     const std::string &error() const { return error_; }
 
@@ -90,6 +92,7 @@ protected:
     StreamProbe probe_;
     double fps_ = 0.0, stream_fps_ = 0.0, scale_ = 1.0;
     const char *origin_ = "container";
+    const char *decoder_ = "images";
     bool images_ = false;
     cv::Size size_;
     std::string error_;
