@@ -6,6 +6,7 @@
 
 #include "gs_finite.h"
 #include "gs_inline.h"
+#include "gs_median.h"
 
 /* thresholds in units of the body's size (stature, px) */
 #define STILL_REL   0.25f  /* resting: slower than this x size per second (as a standing body) */
@@ -157,9 +158,7 @@ static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
     if (back + 3u > held(ft)) return a;
     float b = u_at(f, back + 1u), c = u_at(f, back + 2u);
     if (!fin(a) || !fin(b) || !fin(c)) return a;
-    if (a > b) { float t = a; a = b; b = t; }
-    if (b > c) b = c;
-    return a > b ? a : b;
+    return gs_med3_f(a, b, c);
 }
 
 /* still: the (median) height u_now moved less than STILL_REL x size per second against the
@@ -172,7 +171,7 @@ static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_p
     while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
     float du = u_now - med3_at(ft, f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
     if (NOISE_K * f->noise_px > lim) lim = NOISE_K * f->noise_px;  /* (jitter is no motion) */
-    return GS_FABS(du) < lim;  /* false for NaN */
+    return fabsf(du) < lim;  /* false for NaN (fabsf: a mask, no branch) */
 }
 
 /* speed over the interval ending `back` frames before the newest, px/s (NaN unknown) */
@@ -250,7 +249,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float m = med3_at(ft, f, 0);
     bool st = still(ft, f, m, size_px);
     if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
-        float d2 = GS_FABS(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
+        float d2 = fabsf(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
         if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
         if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
     }

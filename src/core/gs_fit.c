@@ -7,6 +7,7 @@
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
 #include "gs_finite.h"
+#include "gs_select.h"
 
 
 /* A diagonal of R below this fraction of its column's norm means the column is
@@ -43,14 +44,9 @@ typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lan
 /* x86-64 hosts whose CPU has AVX2 take the loops over a fully usable cached window
  * four samples to a register: the same IEEE operations lane by lane, no fused
  * multiply-add (not enabled), sums still added sample after sample */
-#if GS_FIT_FAST && defined(__GNUC__) && defined(__x86_64__)
-#include <immintrin.h>
+#if GS_FIT_FAST && GS_SELECT_AVX2
 #define GS_FIT_AVX2 1
-#define GS_AVX2 __attribute__((target("avx2,popcnt")))
-static bool fit_avx2(void)
-{
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
-}
+#define fit_avx2 gs_select_avx2
 #else
 #define GS_FIT_AVX2 0
 #endif
@@ -521,70 +517,11 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
     return true;
 }
 
-#if GS_FIT_AVX2
-/* Keys [8j, 8j+8) of n, unsigned order made signed; lanes past n read as 0. */
-GS_AVX2 static inline __m256i rank_lanes_avx2(const uint32_t *key, uint32_t n, uint32_t j)
-{
-    uint32_t left = n > 8u * j ? n - 8u * j : 0u;
-    __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)left), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    return _mm256_xor_si256(_mm256_maskload_epi32((const int *)(const void *)&key[8u * j], lanes),
-                            _mm256_set1_epi32(INT32_MIN));
-}
-
-/* Lanes of v below x, and above x, as bits 8j.. of *lt, *gt. */
-GS_AVX2 static inline void rank_bits_avx2(__m256i x, __m256i v, uint32_t j, uint32_t *lt, uint32_t *gt)
-{
-    *lt |= (uint32_t)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(x, v))) << (8u * j);
-    *gt |= (uint32_t)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(v, x))) << (8u * j);
-}
-
-/* Key x ranks k among the keys in v[0..nv) (valid: their lanes): at most k keys lie
- * below it and at most above = n - 1 - k above it. */
-GS_AVX2 static inline bool rank_is_avx2(const __m256i *v, uint32_t nv, uint32_t x_key, uint32_t valid, uint32_t k,
-                                        uint32_t above)
-{
-    __m256i x = _mm256_set1_epi32((int)(x_key ^ 0x80000000u));
-    uint32_t lt = 0, gt = 0, j;
-    for (j = 0; j < nv; j++) {
-        rank_bits_avx2(x, v[j], j, &lt, &gt);
-    }
-    return ((uint32_t)__builtin_popcount(lt & valid) <= k) & ((uint32_t)__builtin_popcount(gt & valid) <= above);
-}
-
-/* The k-th smallest of n <= 32 keys (k < n) by rank, without data-dependent branches
- * but the one that finds it (unsigned order, as select_key's). *at: where to look
- * first (the last median's index: an IRLS step's median is mostly the same sample's),
- * then where it was found. */
-GS_AVX2 static uint32_t select_rank_avx2(const uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
-{
-    uint32_t valid = n == 32u ? ~0u : (1u << n) - 1u, above = n - 1u - k, i;
-    __m256i v[4];
-    v[0] = rank_lanes_avx2(key, n, 0u);
-    v[1] = rank_lanes_avx2(key, n, 1u);
-    if (n <= 16u) {
-        if (*at < n && rank_is_avx2(v, 2u, key[*at], valid, k, above)) {
-            return key[*at];
-        }
-        for (i = 0; i + 1u < n && !rank_is_avx2(v, 2u, key[i], valid, k, above); i++) {
-        }
-    } else {
-        v[2] = rank_lanes_avx2(key, n, 2u);
-        v[3] = rank_lanes_avx2(key, n, 3u);
-        if (*at < n && rank_is_avx2(v, 4u, key[*at], valid, k, above)) {
-            return key[*at];
-        }
-        for (i = 0; i + 1u < n && !rank_is_avx2(v, 4u, key[i], valid, k, above); i++) {
-        }
-    }
-    *at = i; /* the last when no earlier key has rank k */
-    return key[i];
-}
-#endif
 
 /* The k-th smallest of n float bit patterns (non-negative floats order like their
  * bits; key may be reordered): Wirth's selection, partitions about the k-th slot until
  * it holds the key a sort would put there. The same float as sorting. *at: the rank
- * selection's hint (select_rank_avx2). */
+ * selection's hint (gs_select_rank_avx2). */
 static float select_key(uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
 {
     int32_t l = 0, r = (int32_t)n - 1, kk = (int32_t)k; /* n <= GS_FIT_CACHE */
@@ -593,7 +530,7 @@ static float select_key(uint32_t *key, uint32_t n, uint32_t k, uint32_t *at)
 #if GS_FIT_AVX2
     if (n <= 32u && n > 0u && fit_avx2()) {
         /* a short window's median: the partitions' branches would go either way at random */
-        uint32_t b = select_rank_avx2(key, n, k, at);
+        uint32_t b = gs_select_rank_avx2(key, n, k, at);
         memcpy(&v, &b, sizeof v);
         return v;
     }

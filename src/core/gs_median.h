@@ -7,4 +7,29 @@
 /* v[0..n) (n >= 1) sorted ascending in place, and its median */
 gs_real gs_sort_median(gs_real *v, uint32_t n);
 
+#if !defined(__OPTIMIZE_SIZE__) && defined(__GNUC__) && defined(__x86_64__)
+/* x86-64 hosts: x < y ? x : y and x > y ? x : y as minss/maxss, which they are bit for
+ * bit (GCC may turn a median's compare-and-swap into a branch that noisy data mispredicts) */
+static inline float gs_min_f(float x, float y) { __asm__("minss %1, %0" : "+x"(x) : "x"(y)); return x; }
+static inline float gs_max_f(float x, float y) { __asm__("maxss %1, %0" : "+x"(x) : "x"(y)); return x; }
+static inline double gs_min_d(double x, double y) { __asm__("minsd %1, %0" : "+x"(x) : "x"(y)); return x; }
+static inline double gs_max_d(double x, double y) { __asm__("maxsd %1, %0" : "+x"(x) : "x"(y)); return x; }
+#else
+static inline float gs_min_f(float x, float y) { return x < y ? x : y; }
+static inline float gs_max_f(float x, float y) { return x > y ? x : y; }
+static inline double gs_min_d(double x, double y) { return x < y ? x : y; }
+static inline double gs_max_d(double x, double y) { return x > y ? x : y; }
+#endif
+
+/* the median of three (a NaN gives what a compare-and-swap sort of a, b, c would) */
+static inline float gs_med3_f(float a, float b, float c)
+{
+    return gs_max_f(gs_min_f(b, a), gs_min_f(c, gs_max_f(a, b)));
+}
+
+static inline double gs_med3_d(double a, double b, double c)
+{
+    return gs_max_d(gs_min_d(b, a), gs_min_d(c, gs_max_d(a, b)));
+}
+
 #endif
