@@ -596,6 +596,16 @@ static void test_bad_calls(void)
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
     TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_push_point(&p, 2.0, 1, 1, 1, NAN));
     TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_flush(&p));
+    /* a configured span the flight's 32-bit times cannot hold (an unchecked configuration:
+     * the checks allow 5 s) is refused; 67 s, the largest held, is taken */
+    gs_core_config bad = cfg;
+    bad.max_gap_s = NAN;
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_init(&p, &bad, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    bad = cfg;
+    bad.max_flight_s = 68.0f;
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_init(&p, &bad, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    bad.max_flight_s = 67.0f;
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &bad, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
 }
 
 int main(void)
