@@ -507,6 +507,32 @@ static void test_pause_beyond_time_span(void)
     }
 }
 
+/* The noisy stream of seed 99 again on a clock offset_us later: the same flights as ref, to
+ * the bit, with every time shifted by exactly the offset. */
+static void expect_shifted(const sim_track *s, const cam *c, const capture *ref, int64_t offset_us, double t_end)
+{
+    static capture cap;
+    rng_state = 99;
+    g_clock_us = offset_us;
+    run(s, c, &cap, t_end);
+    g_clock_us = 0;
+    TEST_ASSERT_EQUAL_INT(ref->n_jumps, cap.n_jumps);
+    for (int e = 0; e < ref->n_jumps; e++) {
+        const gs_ev_jump *a = &ref->jumps[e], *b = &cap.jumps[e];
+        TEST_ASSERT_TRUE(a->t_takeoff_us + offset_us == b->t_takeoff_us);
+        TEST_ASSERT_TRUE(a->t_land_us + offset_us == b->t_land_us);
+        TEST_ASSERT_TRUE(a->t_apex_us + offset_us == b->t_apex_us);
+        TEST_ASSERT_EQUAL_MEMORY(&a->flight_time_s, &b->flight_time_s, sizeof a->flight_time_s);
+        TEST_ASSERT_EQUAL_MEMORY(&a->a_px_s2, &b->a_px_s2, sizeof a->a_px_s2);
+        TEST_ASSERT_EQUAL_MEMORY(&a->height_m, &b->height_m, sizeof a->height_m);
+        TEST_ASSERT_EQUAL_MEMORY(&a->jump_height_m, &b->jump_height_m, sizeof a->jump_height_m);
+        TEST_ASSERT_EQUAL_UINT32(a->n_samples, b->n_samples);
+        TEST_ASSERT_EQUAL_UINT32(a->n_outliers, b->n_outliers);
+        TEST_ASSERT_EQUAL(a->accepted, b->accepted);
+        TEST_ASSERT_EQUAL_INT(a->reason, b->reason);
+    }
+}
+
 /* Only time differences count: the same noisy stream on a clock 54 years later (Unix
  * time in microseconds) or before zero gives the same flights, to the bit, with every
  * time shifted by exactly the offset. */
@@ -516,30 +542,37 @@ static void test_clock_offset_invariance(void)
     sim_track s;
     make_track(&s, 3, 1.5, 2.5, 1.6, 2.4);
     cam c = {120.0, 0.004, 3.0, 0.4, 0.20, 0.01, 0.21};
-    static capture ref, cap;
+    static capture ref;
     rng_state = 99;
     g_clock_us = 0;
     run(&s, &c, &ref, 9.0);
     TEST_ASSERT_EQUAL_INT(3, ref.n_jumps);
-    for (size_t k = 0; k < sizeof offsets_us / sizeof offsets_us[0]; k++) {
-        rng_state = 99;
-        g_clock_us = offsets_us[k];
-        run(&s, &c, &cap, 9.0);
-        TEST_ASSERT_EQUAL_INT(ref.n_jumps, cap.n_jumps);
-        for (int e = 0; e < ref.n_jumps; e++) {
-            const gs_ev_jump *a = &ref.jumps[e], *b = &cap.jumps[e];
-            TEST_ASSERT_TRUE(a->t_takeoff_us + offsets_us[k] == b->t_takeoff_us);
-            TEST_ASSERT_TRUE(a->t_land_us + offsets_us[k] == b->t_land_us);
-            TEST_ASSERT_TRUE(a->t_apex_us + offsets_us[k] == b->t_apex_us);
-            TEST_ASSERT_EQUAL_MEMORY(&a->flight_time_s, &b->flight_time_s, sizeof a->flight_time_s);
-            TEST_ASSERT_EQUAL_MEMORY(&a->a_px_s2, &b->a_px_s2, sizeof a->a_px_s2);
-            TEST_ASSERT_EQUAL_MEMORY(&a->height_m, &b->height_m, sizeof a->height_m);
-            TEST_ASSERT_EQUAL_MEMORY(&a->jump_height_m, &b->jump_height_m, sizeof a->jump_height_m);
-            TEST_ASSERT_EQUAL_UINT32(a->n_samples, b->n_samples);
-            TEST_ASSERT_EQUAL_UINT32(a->n_outliers, b->n_outliers);
-        }
-    }
+    for (size_t k = 0; k < sizeof offsets_us / sizeof offsets_us[0]; k++) expect_shifted(&s, &c, &ref, offsets_us[k], 9.0);
+}
+
+/* The flight's times inside its window are 32-bit offsets from a 64-bit base: clocks on
+ * which each flight's middle (or its take-off, or its landing) falls where the time's low
+ * 32 bits turn negative as an int32 (2^31 modulo 2^32) or wrap (2^32), near zero, beyond
+ * 2^32 and below zero, give the same flights to the bit. (Local times taken from the low
+ * words alone, or from a wrong base, order such a flight's samples wrongly.) */
+static void test_flight_across_word_boundaries(void)
+{
+    static const int64_t words_us[] = {INT64_C(1) << 31, INT64_C(1) << 32, (INT64_C(1) << 31) + (INT64_C(77) << 32),
+                                       -(INT64_C(1) << 31), -(INT64_C(5) << 32)};
+    sim_track s;
+    make_track(&s, 3, 1.5, 2.5, 1.6, 2.4);
+    cam c = {120.0, 0.004, 3.0, 0.4, 0.20, 0.01, 0.21};
+    static capture ref;
+    rng_state = 99;
     g_clock_us = 0;
+    run(&s, &c, &ref, 9.0);
+    TEST_ASSERT_EQUAL_INT(3, ref.n_jumps);
+    for (int e = 0; e < ref.n_jumps; e++) {
+        const gs_ev_jump *j = &ref.jumps[e];
+        int64_t at_us[3] = {j->t_takeoff_us + (j->t_land_us - j->t_takeoff_us) / 2, j->t_takeoff_us, j->t_land_us};
+        for (size_t w = 0; w < sizeof words_us / sizeof words_us[0]; w++)
+            for (int k = 0; k < 3; k++) expect_shifted(&s, &c, &ref, words_us[w] - at_us[k], 9.0);
+    }
 }
 
 static void test_bad_calls(void)
@@ -563,6 +596,16 @@ static void test_bad_calls(void)
     TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_flush(&p));
     TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_push_point(&p, 2.0, 1, 1, 1, NAN));
     TEST_ASSERT_EQUAL(GS_ESTATE, gs_pipeline_flush(&p));
+    /* a configured span the flight's 32-bit times cannot hold (an unchecked configuration:
+     * the checks allow 5 s) is refused; 67 s, the largest held, is taken */
+    gs_core_config bad = cfg;
+    bad.max_gap_s = NAN;
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_init(&p, &bad, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    bad = cfg;
+    bad.max_flight_s = 68.0f;
+    TEST_ASSERT_EQUAL(GS_EINVAL, gs_pipeline_init(&p, &bad, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
+    bad.max_flight_s = 67.0f;
+    TEST_ASSERT_EQUAL(GS_OK, gs_pipeline_init(&p, &bad, GS_LAYOUT_POINT, storage, sizeof storage, on_event, &cap));
 }
 
 int main(void)
@@ -579,6 +622,7 @@ int main(void)
     RUN_TEST(test_index_base_moves);
     RUN_TEST(test_pause_beyond_time_span);
     RUN_TEST(test_clock_offset_invariance);
+    RUN_TEST(test_flight_across_word_boundaries);
     RUN_TEST(test_bad_calls);
     return UNITY_END();
 }

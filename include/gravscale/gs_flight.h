@@ -29,6 +29,16 @@ const char *gs_flight_state_name(gs_flight_state s);
 #endif
 #define GS_NO_IDX UINT32_MAX
 
+/* Times inside the flight's window (names ending _lus) are int32 microseconds from a
+ * 64-bit base (gs_flight.tb_us) 2^27 us before the ring's newest sample, set when the
+ * samples are examined (a close keeps the base it began with: no sample is examined
+ * while it is pending). Held samples are less than 2^31 us older than the newest, so each
+ * one's local time is exact, and so is a time up to 2^27 us beyond them. GS_LT_NONE: none. */
+#define GS_LT_NONE INT32_MIN
+/* configured spans (gaps, flight lengths, latency) beyond this (67 s; the config checks
+ * allow at most 5 s) are refused: a span of local times is then exact in 32 bits */
+#define GS_FLIGHT_SPAN_MAX_US (1 << 26)
+
 typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 
 /* Frames a flight's close may spread over, one robust fit or boundary search a frame (and
@@ -77,8 +87,8 @@ typedef struct {
     uint32_t in_lo, in_hi;     /* the final fit's samples */
     gs_real cusum;             /* ... the walk's */
     float floor_off_px, floor_on_px, floor_before_px;
-    int64_t t_prev_us;         /* ... the walk's */
-    int64_t T0_us, T1_us, F0_us, F1_us; /* the boundaries */
+    int32_t t_prev_lus;        /* ... the walk's */
+    int32_t T0_lus, T1_lus, F0_lus, F1_lus; /* the boundaries */
     gs_fit_result r;           /* the flight's fit as grown */
 #if GS_CLOSE_LAG_FRAMES > 0
     gs_fit_memo memo;
@@ -113,11 +123,12 @@ typedef struct {
     bool rigid;                /* object size is measured in every frame (ball), not while standing */
     uint32_t track;            /* reported in every event (several objects: one pipeline each) */
     gs_real g_m_s2;
-    /* the configured spans in microseconds (gs_time_us_of_cfg_s) */
-    int64_t min_flight_us, max_flight_us, max_gap_us, landing_latency_us;
+    /* the configured spans in microseconds (gs_time_us_of_cfg_s; at most GS_FLIGHT_SPAN_MAX_US) */
+    int32_t min_flight_us, max_flight_us, max_gap_us, landing_latency_us;
 
     gs_flight_state state;
     uint64_t base;             /* ring index of offset 0: the indices below are offsets from it */
+    int64_t tb_us;             /* time of local 0: the _lus times are microseconds from it */
     uint32_t next;             /* next index to examine */
     uint32_t quiet_from;       /* first index after the last closed candidate */
     int64_t last_t_us;         /* time of the last valid sample, GS_T_NONE none */
@@ -139,7 +150,6 @@ typedef struct {
     int64_t blk_t0_us;
     gs_real peak_u;            /* running maximum once the rise is significant */
     uint32_t peak_idx;
-    int64_t peak_t_us;
 
     /* the open flight candidate */
     gs_fit fit;                /* streaming fit of the accepted in-flight samples */

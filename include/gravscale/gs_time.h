@@ -52,6 +52,23 @@ static inline gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us)
 #endif
 /* The same in seconds. */
 gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us);
+/* A span known to lie within +-INT32_MAX us (two held ring samples, a time inside a
+ * flight window and its fit's centre) in seconds: what gs_time_span_s gives for it, with
+ * 32-bit arguments (a 64-bit time costs two registers and instructions on a 32-bit core).
+ * Inline and out of line as gs_time_span_us. */
+#ifdef __OPTIMIZE_SIZE__
+gs_real gs_time_span32_s(int32_t d_us);
+#endif
+#if !defined(__OPTIMIZE_SIZE__) || defined(GS_TIME_DEFINE)
+#ifdef GS_TIME_DEFINE
+__attribute__((noinline)) gs_real gs_time_span32_s(int32_t d_us)
+#else
+static inline gs_real gs_time_span32_s(int32_t d_us)
+#endif
+{
+    return (gs_real)d_us / GS_R(1e6);
+}
+#endif
 /* t + ds rounded to the nearest microsecond; GS_T_NONE when t is not gs_time_ok,
  * or ds is not finite or |ds| >= 2^31 s. */
 int64_t gs_time_add_s(int64_t t_us, gs_real ds);

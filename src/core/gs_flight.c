@@ -103,6 +103,24 @@ static const gs_sample_full *at(const gs_flight *f, uint32_t i, gs_sample_full *
     return gs_ring_get(f->ring, ring_idx(f, i), buf) ? buf : NULL;
 }
 
+/* The flight's times (_lus): int32 microseconds from f->tb_us (gs_flight.h). The local
+ * time of an absolute one within their range: the low words alone give it exactly, and a
+ * 32-bit core loads and subtracts only those. */
+static inline __attribute__((always_inline)) int32_t lt_of(const gs_flight *f, int64_t t_us)
+{
+    return (int32_t)((uint32_t)(uint64_t)t_us - (uint32_t)(uint64_t)f->tb_us);
+}
+
+/* ... and the absolute time of a local one */
+static int64_t abs_of(const gs_flight *f, int32_t t_lus) { return f->tb_us + t_lus; }
+
+/* local time of ring sample i (the packed field is its low word), GS_LT_NONE when not held */
+static int32_t lt_at(const gs_flight *f, uint32_t i)
+{
+    const gs_sample *s = gs_ring_at(f->ring, ring_idx(f, i));
+    return s ? (int32_t)(s->t_us - (uint32_t)(uint64_t)f->tb_us) : GS_LT_NONE;
+}
+
 /* time of ring sample i, GS_T_NONE when not held */
 static int64_t t_at(const gs_flight *f, uint32_t i)
 {
@@ -119,17 +137,33 @@ static bool usable(const gs_sample_full *s)
 
 static bool held(const gs_flight *f, uint32_t i) { return gs_ring_at(f->ring, ring_idx(f, i)) != NULL; }
 
-/* t1 - t0 longer than a span (false when either time is unknown) */
-static NOINLINE bool span_over(int64_t t1_us, int64_t t0_us, int64_t span_us)
+/* t1 - t0 longer than a span (false when either time is unknown); both are held samples'
+ * times, less than 2^31 us apart */
+static NOINLINE bool span_over(int32_t t1_lus, int32_t t0_lus, int32_t span_us)
 {
-    return t1_us != GS_T_NONE && t0_us != GS_T_NONE && t1_us - t0_us > span_us;
+    return t1_lus != GS_LT_NONE && t0_lus != GS_LT_NONE && t1_lus - t0_lus > span_us;
 }
 
-/* How far t lies past T toward side (+1: later, -1: earlier); negative: on the flight's side. */
-static int64_t past_us(int64_t t_us, int64_t T_us, int side)
+/* t1 - t0 for two times less than 2^31 us apart (two held ring samples; a time inside a
+ * flight window and its fit's centre, the window's samples held with it): the low words
+ * alone give it exactly, and a 32-bit core loads and subtracts only those. */
+static inline __attribute__((always_inline)) int32_t near_us(int64_t t1_us, int64_t t0_us)
 {
-    int64_t d = t_us - T_us;
-    return side < 0 ? -d : d;
+    return (int32_t)(uint32_t)((uint64_t)t1_us - (uint64_t)t0_us);
+}
+
+/* Does t lie past T toward side (+1: later, -1: earlier), away from the flight? */
+static bool beyond(int32_t t_lus, int32_t T_lus, int side)
+{
+    return side < 0 ? t_lus < T_lus : t_lus > T_lus;
+}
+
+/* How far t lies past T toward side in seconds; negative: on the flight's side. In 64 bits:
+ * a grid point may lie up to a frame beyond the held samples (see refine_boundary). */
+static gs_real past_s(int32_t t_lus, int32_t T_lus, int side)
+{
+    int64_t d = (int64_t)t_lus - T_lus;
+    return gs_time_span_s(side < 0 ? -d : d, 0);
 }
 
 /* Ring sample i unpacked into *buf when held and usable, else NULL. */
@@ -273,6 +307,21 @@ static gs_real med3(gs_real a, gs_real b, gs_real c)
 static void restart_levels(gs_flight *f, uint32_t i);
 static NOINLINE float last_stand_size(const gs_flight *f);
 
+/* The local times' base (gs_flight.h): examine sets it, when no close is pending */
+#define LT_NEWEST 0x8000000  /* the newest sample's local time: 2^27 */
+static void set_time_base(gs_flight *f)
+{
+    if (f->ring->t_last_us != GS_T_NONE) f->tb_us = f->ring->t_last_us - LT_NEWEST;
+}
+
+/* a configured span in microseconds, false when it is not within [0, GS_FLIGHT_SPAN_MAX_US] */
+static bool span_cfg_us(float s, int32_t *span_us)
+{
+    int64_t us = gs_time_us_of_cfg_s(s);
+    *span_us = (int32_t)(us & 0x7FFFFFFF);
+    return us != GS_T_NONE && us <= GS_FLIGHT_SPAN_MAX_US;
+}
+
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
@@ -285,10 +334,9 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->on_event = on_event;
     f->ctx = ctx;
     f->g_m_s2 = gs_core_config_g(cfg);
-    f->min_flight_us = gs_time_us_of_cfg_s(cfg->min_flight_s);
-    f->max_flight_us = gs_time_us_of_cfg_s(cfg->max_flight_s);
-    f->max_gap_us = gs_time_us_of_cfg_s(cfg->max_gap_s);
-    f->landing_latency_us = gs_time_us_of_cfg_s(cfg->landing_latency_s);
+    if (!span_cfg_us(cfg->min_flight_s, &f->min_flight_us) || !span_cfg_us(cfg->max_flight_s, &f->max_flight_us) ||
+        !span_cfg_us(cfg->max_gap_s, &f->max_gap_us) || !span_cfg_us(cfg->landing_latency_s, &f->landing_latency_us))
+        return GS_EINVAL;
     uint64_t head = gs_ring_head(ring);
     f->base = head > GS_FLIGHT_IDX_KEEP ? head - GS_FLIGHT_IDX_KEEP : 0u;
     f->next = idx_of(f, head);
@@ -371,9 +419,9 @@ static gs_real fit_sigma(const gs_flight *f, const gs_fit_result *r)
 
 /* variance factor of the fitted value at t: |R^-T x|^2 with x = (1, tau, tau^2) (not finite
  * where R is singular) */
-static gs_real pred_var_factor(const gs_fit *fit, int64_t t_us)
+static gs_real pred_var_factor(const gs_fit *fit, int32_t dt_us)
 {
-    gs_real tau = gs_time_span_s(t_us, fit->t0_us) / fit->tscale_s;
+    gs_real tau = gs_time_span32_s(dt_us) / fit->tscale_s;
     gs_real x0 = GS_R(1.0), x1 = tau, x2 = tau * tau;
     const gs_real *r = fit->r;  /* r00 r01 r02 r11 r12 r22 */
     gs_real z0 = x0 / r[0];
@@ -389,7 +437,7 @@ static gs_real pred_var_factor(const gs_fit *fit, int64_t t_us)
 static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sample_full *s, gs_real *z)
 {
     const gs_fit *fit = &f->fit;
-    gs_real dt = gs_time_span_s(s->t_us, r->t0_us);
+    gs_real dt = gs_time_span32_s(near_us(s->t_us, r->t0_us));
     gs_real ax = (gs_real)r->ax_px_s2, ay = (gs_real)r->ay_px_s2, a = (gs_real)r->a_px_s2;
     gs_real px = (gs_real)r->x0_px + (gs_real)r->vx_px_s * dt + GS_R(0.5) * ax * dt * dt;
     gs_real py = (gs_real)r->y0_px + (gs_real)r->vy_px_s * dt + GS_R(0.5) * ay * dt * dt;
@@ -399,7 +447,7 @@ static bool test_sample(const gs_flight *f, const gs_fit_result *r, const gs_sam
     gs_real up = -(ex * gx + ey * gy);
     gs_real perp = ex * (-gy) + ey * gx;
     gs_real sig = (gs_real)fit_sigma(f, r);
-    gs_real vf = pred_var_factor(fit, s->t_us);
+    gs_real vf = pred_var_factor(fit, near_us(s->t_us, fit->t0_us));
     gs_real tot = sig * GS_SQRT(GS_R(1.0) + (finite_r(vf) ? vf : GS_R(1e6)));
     *z = (gs_real)(up / tot);
     return !(GS_FABSR(perp) > GS_R(GROSS_OUTLIER) * tot || up < -GS_R(GROSS_OUTLIER) * tot);
@@ -427,10 +475,10 @@ static NOINLINE uint32_t frame_dt_q4(const gs_flight *f)
     return f->dt_med_q4 ? f->dt_med_q4 : DT_DEFAULT_Q4;
 }
 
-/* the same in whole microseconds */
-static int64_t frame_dt_us(const gs_flight *f)
+/* the same in whole microseconds (at most DT_MAX_US) */
+static int32_t frame_dt_us(const gs_flight *f)
 {
-    return (int64_t)((frame_dt_q4(f) + 8u) >> 4);
+    return (int32_t)((frame_dt_q4(f) + 8u) >> 4);
 }
 
 /* Frame steps in a span, ceil(span * per_frame / frame interval), where a span within
@@ -438,13 +486,13 @@ static int64_t frame_dt_us(const gs_flight *f)
  * microseconds and the interval a running mean, so a span of exactly k frames comes out a
  * hair above or below k (an integer division; spans beyond 2^26 / per_frame us give
  * UINT32_MAX). */
-static NOINLINE uint32_t frame_steps(const gs_flight *f, int64_t span_us, uint32_t per_frame)
+static NOINLINE uint32_t frame_steps(const gs_flight *f, uint32_t span_us, uint32_t per_frame)
 {
-    if (span_us <= 0) return 0;
-    uint64_t num = (uint64_t)span_us * 16u * per_frame;
-    if (num > UINT32_MAX) return UINT32_MAX;
-    uint32_t dt = frame_dt_q4(f), q = (uint32_t)num / dt;
-    return (uint32_t)num - q * dt > dt / 64u ? q + 1u : q;
+    if (span_us == 0) return 0;
+    if (span_us > UINT32_MAX / (16u * per_frame)) return UINT32_MAX;
+    uint32_t num = span_us * 16u * per_frame;
+    uint32_t dt = frame_dt_q4(f), q = num / dt;
+    return num - q * dt > dt / 64u ? q + 1u : q;
 }
 
 /* the frame interval follows the stream: a running mean of intervals, in 1/16 us */
@@ -620,14 +668,14 @@ static NOINLINE gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, 
  * when true (scratch otherwise). */
 static bool refit_range(gs_flight *f, fit_memo *m, uint32_t lo, uint32_t hi, gs_fit_result *r)
 {
-    int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi);
-    if (t_lo == GS_T_NONE || t_hi == GS_T_NONE || hi <= lo) return false;
+    int32_t t_lo = lt_at(f, lo), t_hi = lt_at(f, hi);
+    if (t_lo == GS_LT_NONE || t_hi == GS_LT_NONE || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     if (robust_fit(f, m, lo, count, GS_FIT_IRLS, min_scale, r) != GS_OK)
         return false;
-    int64_t tspan = t_hi - t_lo;
-    gs_fit_init(&f->fit, t_lo + tspan / 2, tspan > 0 ? tspan : frame_dt_us(f));
+    int32_t tspan = t_hi - t_lo;  /* (two held samples) */
+    gs_fit_init(&f->fit, abs_of(f, t_lo + tspan / 2), tspan > 0 ? tspan : frame_dt_us(f));
     for (uint32_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = usable_at(f, i, &s_b);
@@ -822,8 +870,8 @@ static gs_real pw_ssr_solve_l3(gs_real A[4][4], gs_real b[4], gs_real yy, gs_rea
  * (side < 0, take-off) or alpha/2 (t - T)^2 for t > T (side > 0, landing). Contact is
  * a real force, so alpha >= alpha_min_px (half of g in the image): otherwise a
  * boundary placed inside the flight could absorb flight samples for free. */
-static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_lo, int64_t t_hi,
-                            int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px,
+static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int32_t t_lo, int32_t t_hi,
+                            int32_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px,
                             const gs_fit_result *r)
 {
     /* called per boundary candidate and sample: gs_real. In float, u is taken about
@@ -832,7 +880,7 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int64
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
     /* tau in [-1, 1] over [t_lo, t_hi]: centre tc, half-width ts */
-    gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
+    gs_real ts = GS_R(0.5) * gs_time_span32_s(t_hi - t_lo);
     gs_real ts2 = ts * ts;
     for (uint32_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
@@ -840,9 +888,10 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int64
         const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
         if (!s) continue;  /* gross outliers out */
         gs_real w = (gs_real)s->w;
-        /* ((t - t_lo) - (t_hi - t)) / (t_hi - t_lo): exact integer spans in */
-        gs_real tau = gs_time_span_s(s->t_us - t_lo, t_hi - s->t_us) / (ts + ts);
-        gs_real d = gs_time_span_s(past_us(s->t_us, T, side), 0);
+        /* ((t - t_lo) - (t_hi - t)) / (t_hi - t_lo): exact integer spans in (all within [t_lo, t_hi]) */
+        int32_t t = lt_of(f, s->t_us);
+        gs_real tau = gs_time_span32_s((t - t_lo) - (t_hi - t)) / (ts + ts);
+        gs_real d = past_s(t, T, side);
         gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
         gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
@@ -863,7 +912,7 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int64
  * (an added zero leaves a sum as it is). The firmware's code budget is full: it sums anew. */
 #define PW_CACHE 64  /* samples past some grid point (contact samples and the search's reach inside) */
 typedef struct {
-    int64_t t_us;
+    int32_t t_lus;
     gs_real w, x[3], u;
 } pw_sample;
 typedef struct {
@@ -876,13 +925,13 @@ typedef struct {
 
 /* pw's T-independent sums over [lo, hi]; false when more than PW_CACHE samples lie past
  * T_reach (the grid point reaching furthest into the flight) */
-static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_lo, int64_t t_hi,
-                       int64_t T_reach, int side, const gs_fit_result *r, pw_sums *P)
+static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int32_t t_lo, int32_t t_hi,
+                       int32_t T_reach, int side, const gs_fit_result *r, pw_sums *P)
 {
     memset(P, 0, offsetof(pw_sums, L));
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
-    gs_real ts = GS_R(0.5) * gs_time_span_s(t_hi, t_lo);
+    gs_real ts = GS_R(0.5) * gs_time_span32_s(t_hi - t_lo);
     P->ts2 = ts * ts;
     for (uint32_t i = lo; i <= hi; i++) {
         gs_sample_full s_b;
@@ -890,7 +939,8 @@ static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_l
         const gs_sample_full *s = tested_at(f, r, i, &s_b, &z);
         if (!s) continue;
         gs_real w = (gs_real)s->w;
-        gs_real tau = gs_time_span_s(s->t_us - t_lo, t_hi - s->t_us) / (ts + ts);
+        int32_t t = lt_of(f, s->t_us);
+        gs_real tau = gs_time_span32_s((t - t_lo) - (t_hi - t)) / (ts + ts);
         gs_real x[3] = {GS_R(1.0), tau, tau * tau};
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
         gs_real u = (gs_real)u_of(f, s) - u_c;
@@ -899,10 +949,10 @@ static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_l
             for (int m = 0; m < 3; m++) P->A[k][m] += w * x[k] * x[m];
         }
         P->yy += w * u * u;
-        if (past_us(s->t_us, T_reach, side) > 0) {
+        if (beyond(t, T_reach, side)) {
             if (P->n == PW_CACHE) return false;
             pw_sample *c = &P->s[P->n++];
-            c->t_us = s->t_us;
+            c->t_lus = t;
             c->w = w;
             memcpy(c->x, x, sizeof x);
             c->u = u;
@@ -916,7 +966,7 @@ static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int64_t t_l
 }
 
 /* piecewise_ssr at T from the prepared sums */
-static gs_real pw_ssr_at(pw_sums *P, int64_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
+static gs_real pw_ssr_at(pw_sums *P, int32_t T, int side, gs_real alpha_min_px, gs_real alpha_max_px)
 {
     gs_real A[4][4] = {{0}}, b[4] = {0};
     for (int k = 0; k < 3; k++) {
@@ -925,7 +975,7 @@ static gs_real pw_ssr_at(pw_sums *P, int64_t T, int side, gs_real alpha_min_px, 
     }
     for (uint32_t j = 0; j < P->n; j++) {
         const pw_sample *c = &P->s[j];
-        gs_real d = gs_time_span_s(past_us(c->t_us, T, side), 0);
+        gs_real d = past_s(c->t_lus, T, side);
         if (!(d > GS_R(0.0))) continue;  /* h = 0 */
         gs_real w = c->w, h = GS_R(0.5) * d * d / P->ts2;
         gs_real x[4] = {c->x[0], c->x[1], c->x[2], h};
@@ -942,37 +992,42 @@ static gs_real pw_ssr_at(pw_sums *P, int64_t T, int side, gs_real alpha_min_px, 
 
 /* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
  * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
-static int64_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int side,
+static int32_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int side,
                                uint32_t edge_in, uint32_t edge_out, gs_real penalty,
                                const gs_fit_result *r)
 {
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
     gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
     /* all held: the contact samples were tested, the flight lies between them and the newest */
-    int64_t t_lo = t_at(f, lo), t_hi = t_at(f, hi), t_in = t_at(f, edge_in), t_out = t_at(f, edge_out);
-    if (t_hi <= t_lo) return GS_T_NONE;
-    /* search between the outermost contact sample and a little inside the flight */
-    int64_t dt = frame_dt_us(f);
-    int64_t inside = BOUNDARY_IN_US > dt ? BOUNDARY_IN_US : dt;
-    int64_t t_edge = t_in + (side < 0 ? inside : -inside);
-    int64_t t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
-    uint32_t n_steps = frame_steps(f, t_to - t_from, BOUNDARY_STEPS);
+    int32_t t_lo = lt_at(f, lo), t_hi = lt_at(f, hi), t_in = lt_at(f, edge_in), t_out = lt_at(f, edge_out);
+    if (t_hi <= t_lo) return GS_LT_NONE;
+    /* search between the outermost contact sample and a little inside the flight: the grid
+     * reaches at most a frame interval (2^26 us) beyond the held samples, and spans it less
+     * than 2^31 + 2^26 us (unsigned) */
+    int32_t dt = frame_dt_us(f);
+    int32_t inside = BOUNDARY_IN_US > dt ? BOUNDARY_IN_US : dt;
+    int32_t t_edge = t_in + (side < 0 ? inside : -inside);
+    int32_t t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
+    uint32_t span_us = (uint32_t)t_to - (uint32_t)t_from;
+    uint32_t n_steps = frame_steps(f, span_us, BOUNDARY_STEPS);
     int steps = n_steps < 1 ? 1 : n_steps > 400 ? 400 : (int)n_steps;
-    gs_real span_s = gs_time_span_s(t_to, t_from);
+    gs_real span_s = gs_time_span_s(span_us, 0);
     gs_real best = INFINITY;
-    int64_t best_T = GS_T_NONE;
+    int32_t best_T = GS_LT_NONE;
 #ifndef __OPTIMIZE_SIZE__
     pw_sums P;
-    int64_t T_reach = GS_T_NONE;  /* the grid point furthest toward the flight */
+    int32_t T_reach = GS_LT_NONE;  /* the grid point furthest toward the flight */
     for (int k = 0; k <= steps; k++) {
-        int64_t T = gs_time_add_s(t_from, span_s * (gs_real)k / (gs_real)steps);
-        if (T == GS_T_NONE) { T_reach = GS_T_NONE; break; }  /* (no grid: the sums anew) */
-        if (k == 0 || past_us(T, T_reach, side) < 0) T_reach = T;
+        int64_t off_us = gs_time_add_s(0, span_s * (gs_real)k / (gs_real)steps);
+        if (off_us == GS_T_NONE) { T_reach = GS_LT_NONE; break; }  /* (no grid: the sums anew) */
+        int32_t T = (int32_t)((uint32_t)t_from + (uint32_t)off_us);
+        if (k == 0 || beyond(T_reach, T, side)) T_reach = T;
     }
-    bool prepared = T_reach != GS_T_NONE && pw_prepare(f, lo, hi, t_lo, t_hi, T_reach, side, r, &P);
+    bool prepared = T_reach != GS_LT_NONE && pw_prepare(f, lo, hi, t_lo, t_hi, T_reach, side, r, &P);
 #endif
     for (int k = 0; k <= steps; k++) {
-        int64_t T = gs_time_add_s(t_from, span_s * (gs_real)k / (gs_real)steps);
+        /* t_from + the offset: its value lies within the local range (see above) */
+        int32_t T = (int32_t)((uint32_t)t_from + (uint32_t)gs_time_add_s(0, span_s * (gs_real)k / (gs_real)steps));
 #ifndef __OPTIMIZE_SIZE__
         gs_real ssr = prepared ? pw_ssr_at(&P, T, side, alpha_min_px, alpha_max_px)
                                : piecewise_ssr(f, lo, hi, t_lo, t_hi, T, side, alpha_min_px, alpha_max_px, r);
@@ -980,7 +1035,7 @@ static int64_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int
         gs_real ssr = piecewise_ssr(f, lo, hi, t_lo, t_hi, T, side, alpha_min_px, alpha_max_px, r);
 #endif
         /* dropping samples the online test took as flight must pay for itself */
-        if (past_us(T, t_in, side) < 0) ssr += penalty;
+        if (beyond(t_in, T, side)) ssr += penalty;
         if (ssr < best - GS_R(1e-12)) { best = ssr; best_T = T; }
     }
     return best_T;
@@ -1039,7 +1094,7 @@ static gs_real rigid_size(const gs_flight *f, uint32_t lo, uint32_t hi, gs_real 
 static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, bool *spent)
 {
     uint32_t floor_idx = history_floor(f);
-    int64_t t_seed = t_at(f, f->seed_idx);
+    int32_t t_seed = lt_at(f, f->seed_idx);
     uint32_t walked = 0;
 #if GS_CLOSE_LAG_FRAMES > 0
     bool due = c->alarm_due;  /* the walk stopped at an alarm: its refit first */
@@ -1055,9 +1110,10 @@ static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, 
             const gs_sample_full *s = at(f, i, &s_b);
             if (!s) break;
             if (!usable(s)) continue;
-            if (span_over(c->t_prev_us, s->t_us, f->max_gap_us)) break;
-            if (span_over(t_seed, s->t_us, f->max_flight_us)) break;
-            c->t_prev_us = s->t_us;
+            int32_t t = lt_of(f, s->t_us);
+            if (span_over(c->t_prev_lus, t, f->max_gap_us)) break;
+            if (span_over(t_seed, t, f->max_flight_us)) break;
+            c->t_prev_lus = t;
             walked++;
             gs_real z;
             if (!test_sample(f, &c->r, s, &z)) {
@@ -1129,14 +1185,14 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t
 /* The boundary time on one side (GS_T_NONE: unknown) from the flight's edge and the contact
  * samples past it (those end where contact was detected, alarm: further out the ground
  * phase is no longer a constant force); *outer = the outermost contact sample. */
-static int64_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool alarm,
+static int32_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool alarm,
                             uint32_t edge, uint32_t other_edge, bool refine, gs_real pen,
                             uint32_t *outer)
 {
     const gs_fit_result *r = &c->r;
     uint32_t first = edge;  /* the first contact sample */
     *outer = edge;
-    if (!refine) return GS_T_NONE;
+    if (!refine) return GS_LT_NONE;
     uint32_t n = alarm ? contact_run(f, r, edge, side, c->head, outer, &first) : 0;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
@@ -1144,25 +1200,25 @@ static int64_t boundary_time(const gs_flight *f, const gs_close *c, int side, bo
         return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
                                side, edge, *outer, pen, r);
     if (n == 1) {
-        int64_t t_first = t_at(f, first), t_edge = t_at(f, edge);  /* both held: L is */
+        int32_t t_first = lt_at(f, first), t_edge = lt_at(f, edge);  /* both held: L is */
         return t_edge + (t_first - t_edge) / 2;
     }
-    return GS_T_NONE;
+    return GS_LT_NONE;
 }
 
 /* Is sample i inside the flight on this side: short of the boundary time T or, T unknown,
  * not beyond the grown edge? (false when not held) */
-static bool inside_edge(const gs_flight *f, uint32_t i, int64_t T, int side, uint32_t edge)
+static bool inside_edge(const gs_flight *f, uint32_t i, int32_t T, int side, uint32_t edge)
 {
-    int64_t t = t_at(f, i);
-    if (t == GS_T_NONE) return false;
-    if (T == GS_T_NONE) return side < 0 ? i >= edge : i <= edge;
-    return past_us(t, T, side) < 0;
+    int32_t t = lt_at(f, i);
+    if (t == GS_LT_NONE) return false;
+    if (T == GS_LT_NONE) return side < 0 ? i >= edge : i <= edge;
+    return beyond(T, t, side);
 }
 
 /* The flight's outermost sample on one side: from `from` step toward `to` (inward)
  * until a sample is inside the flight (inside_edge) or `to` is reached. */
-static uint32_t trim_edge(const gs_flight *f, uint32_t from, uint32_t to, int64_t T, int side,
+static uint32_t trim_edge(const gs_flight *f, uint32_t from, uint32_t to, int32_t T, int side,
                           uint32_t edge)
 {
     uint32_t i = from;
@@ -1212,7 +1268,7 @@ static uint8_t close_start(gs_flight *f, gs_close *c)
     c->walk_i = c->clean = f->fl_first;
     c->outliers = 0;
     c->cusum = GS_R(0.0);
-    c->t_prev_us = t_at(f, f->fl_first);
+    c->t_prev_lus = lt_at(f, f->fl_first);
     c->left_alarm = GS_NO_IDX;
 #if GS_CLOSE_LAG_FRAMES > 0
     c->alarm_due = false;
@@ -1236,7 +1292,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
     /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
     if (GS_WITH_POSE) {  /* (read only where a layout shows feet) */
         c->floor_off_px = c->floor_on_px = c->floor_before_px = NAN;
-        c->F0_us = c->F1_us = GS_T_NONE;
+        c->F0_lus = c->F1_lus = GS_LT_NONE;
         c->feet_contradict = false;  /* the feet, in view, show no flight there */
         c->fell = false;             /* ... or a fall to a lower floor */
     }
@@ -1246,52 +1302,55 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
 
-            c->F0_us = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &c->floor_off_px);
+            /* (both within the local range: near the flight's held samples) */
+            int64_t F0_us = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &c->floor_off_px);
             int64_t from = c1 - FEET_BEFORE_COM_US > apex_us ? c1 - FEET_BEFORE_COM_US : apex_us;
-            c->F1_us = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &c->floor_on_px, &c->floor_before_px);
+            int64_t F1_us = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &c->floor_on_px, &c->floor_before_px);
+            c->F0_lus = F0_us != GS_T_NONE ? lt_of(f, F0_us) : GS_LT_NONE;
+            c->F1_lus = F1_us != GS_T_NONE ? lt_of(f, F1_us) : GS_LT_NONE;
         }
-        int64_t F0 = c->F0_us, F1 = c->F1_us;
+        int32_t F0 = c->F0_lus, F1 = c->F1_lus;
         DBG("feet: com %lld..%lld apex %lld -> F0 %lld F1 %lld floors %.1f %.1f before %.1f\n", (long long)c0,
             (long long)c1, (long long)apex_us, (long long)F0, (long long)F1, c->floor_off_px, c->floor_on_px,
             c->floor_before_px);
-        if (F1 != GS_T_NONE && F1 <= F0) c->F0_us = c->F1_us = F0 = F1 = GS_T_NONE;
+        if (F1 != GS_LT_NONE && F1 <= F0) c->F0_lus = c->F1_lus = F0 = F1 = GS_LT_NONE;
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
          * rested, as in quick hops, say nothing: the COM times the flight) */
         if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
             c->feet_contradict = gs_feet_resting_at(&f->feet, apex_us) ||
-                              (F0 != GS_T_NONE && F1 == GS_T_NONE && gs_feet_airborne(&f->feet));
+                              (F0 != GS_LT_NONE && F1 == GS_LT_NONE && gs_feet_airborne(&f->feet));
         /* a fall: the feet went well below the floor they left (a box): after a clean take-off
          * below its floor, else below the floor they had rested on */
         float size_px = (float)gate_size(f, L);
         float d_px = f->feet.delta_rel * size_px;
         /* (toes stop where they land: after it a squat's or a moving camera's frames are no
          * floor; an ankle's recrossing is above the floor it then comes down to) */
-        float low_px = F1 != GS_T_NONE && f->feet.stop_touch ? c->floor_on_px : gs_feet_low_px(&f->feet);
-        c->fell = F0 != GS_T_NONE ? low_px < c->floor_off_px - d_px - FALL_FLOOR_REL * size_px
+        float low_px = F1 != GS_LT_NONE && f->feet.stop_touch ? c->floor_on_px : gs_feet_low_px(&f->feet);
+        c->fell = F0 != GS_LT_NONE ? low_px < c->floor_off_px - d_px - FALL_FLOOR_REL * size_px
                                : gs_feet_sank_since(&f->feet, c0);
     }
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
-    bool feet = GS_WITH_POSE && c->F0_us != GS_T_NONE && c->F1_us != GS_T_NONE;
+    bool feet = GS_WITH_POSE && c->F0_lus != GS_LT_NONE && c->F1_lus != GS_LT_NONE;
     if (GS_WITH_POSE) c->feet = feet;
     bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
     gs_real sig = fit_sigma(f, r);
     gs_real pen = DROP_PENALTY * sig * sig;
     uint32_t lo, hi;  /* the outermost contact samples */
-    int64_t T0 = c->T0_us = boundary_time(f, c, -1, c->left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
-    int64_t T1 = c->T1_us = boundary_time(f, c, +1, c->right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
+    int32_t T0 = c->T0_lus = boundary_time(f, c, -1, c->left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
+    int32_t T1 = c->T1_lus = boundary_time(f, c, +1, c->right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         (long long)T0, (long long)T1, r->a_px_s2);
     /* with the feet's times: the flight and the nearly free frames beside it (the push-off's
      * last tens of ms, when the ground already bears less than the weight; the first of the
      * landing) as far as the parabola explains them */
-    int64_t W0 = T0, W1 = T1;
+    int32_t W0 = T0, W1 = T1;
     if (feet) {
-        W0 = c->F0_us - FEET_FREE_EDGE_US;
-        W1 = c->F1_us + FEET_FREE_EDGE_US;
+        W0 = c->F0_lus - FEET_FREE_EDGE_US;
+        W1 = c->F1_lus + FEET_FREE_EDGE_US;
     }
     c->in_lo = trim_edge(f, lo, hi, W0, -1, L);
     c->in_hi = trim_edge(f, hi, c->in_lo, W1, +1, R);
@@ -1304,7 +1363,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
 static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
 {
     uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
-    int64_t T0 = c->T0_us, T1 = c->T1_us;
+    int32_t T0 = c->T0_lus, T1 = c->T1_lus;
     uint32_t in_lo = c->in_lo, in_hi = c->in_hi;
     gs_sample_full sf_b, sl_b;
     const gs_sample_full *sf = at(f, in_lo, &sf_b), *sl = at(f, in_hi, &sl_b);
@@ -1319,30 +1378,32 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
 
     /* samples actually inside the flight (usable) and rejected as outliers */
     uint32_t n_in = 0, n_out = 0;
-    int64_t max_gap_in = 0;
-    int64_t t_prev = GS_T_NONE;
+    int32_t max_gap_in = 0;
+    int32_t t_prev = GS_LT_NONE;
     for (uint32_t i = in_lo; i <= in_hi; i++) {
         gs_sample_full s_b;
         const gs_sample_full *s = at(f, i, &s_b);
         if (!s || !(s->w > 0.0f)) continue;  /* frames missing from the source */
-        if (t_prev != GS_T_NONE && s->t_us - t_prev > max_gap_in) max_gap_in = s->t_us - t_prev;
-        t_prev = s->t_us;
+        int32_t t = lt_of(f, s->t_us);
+        if (t_prev != GS_LT_NONE && t - t_prev > max_gap_in) max_gap_in = t - t_prev;  /* (held: exact) */
+        t_prev = t;
         if (!usable(s)) continue;
         n_in++;
         if (!gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    int64_t half_dt = frame_dt_us(f) / 2;
-    if (T0 == GS_T_NONE) T0 = sf->t_us - half_dt;
-    if (T1 == GS_T_NONE) T1 = sl->t_us + half_dt;
+    int32_t half_dt = frame_dt_us(f) / 2;
+    if (T0 == GS_LT_NONE) T0 = lt_of(f, sf->t_us) - half_dt;
+    if (T1 == GS_LT_NONE) T1 = lt_of(f, sl->t_us) + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
     bool feet = GS_WITH_POSE && c->feet;  /* (no layout with feet: their code folds away) */
-    int64_t F1 = GS_WITH_POSE ? c->F1_us : GS_T_NONE;
+    int32_t F1 = GS_WITH_POSE ? c->F1_lus : GS_LT_NONE;
     if (feet) {  /* (one end from the feet and the other from the COM would mix two definitions) */
-        T0 = c->F0_us;
+        T0 = c->F0_lus;
         T1 = F1;
     }
+    int64_t T0_us = abs_of(f, T0), T1_us = abs_of(f, T1);
 
     gs_event ev;
     memset(&ev, 0, sizeof ev);
@@ -1350,9 +1411,9 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
     gs_ev_jump *j = &ev.u.jump;
     j->index = f->n_flights;
     j->track = f->track;
-    j->t_takeoff_us = T0;
-    j->t_land_us = T1;
-    j->flight_time_s = gs_time_span_s(T1, T0);
+    j->t_takeoff_us = T0_us;
+    j->t_land_us = T1_us;
+    j->flight_time_s = gs_time_span_s(T1_us, T0_us);
     j->n_samples = n_in;
     j->n_outliers = n_out;
     j->height_m = j->height_se_m = NAN;  /* the other fields are all set below (memset: not accepted, no reason) */
@@ -1372,15 +1433,15 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         j->q_m_per_px = q;
         gs_real apex_s = fit_apex_s(&fr);
         j->t_apex_us = gs_time_add_s(fr.t0_us, apex_s);
-        gs_real rise_t = gs_time_span_s(fr.t0_us, T0) + apex_s;
+        gs_real rise_t = gs_time_span_s(fr.t0_us, T0_us) + apex_s;
         j->jump_height_m = g * j->flight_time_s * j->flight_time_s / GS_R(8.0);
         j->com_rise_m = GS_R(0.5) * g * rise_t * rise_t;
         j->takeoff_velocity_m_s = g * rise_t;
         /* a rebound: the ground contact since the last landing, no stance between */
         j->contact_time_s = j->rsi = NAN;
-        if (f->last_land_us != GS_T_NONE && T0 > f->last_land_us && T0 - f->last_land_us <= CONTACT_MAX_US &&
+        if (f->last_land_us != GS_T_NONE && T0_us > f->last_land_us && T0_us - f->last_land_us <= CONTACT_MAX_US &&
             !(f->stand_last_us > f->last_land_us)) {
-            j->contact_time_s = gs_time_span_s(T0, f->last_land_us);
+            j->contact_time_s = gs_time_span_s(T0_us, f->last_land_us);
             j->rsi = j->jump_height_m / j->contact_time_s;
         }
         if (!IS_RIGID(f) && !feet) j->warnings |= GS_WARN_COM_TIMED;
@@ -1403,16 +1464,16 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         gs_real gsize = finite_r(size) ? size : gate_size(f, in_lo);
         bool flight_like = plausible_fall(f, &fr, gsize);
         if (!flight_like) goto done;
-        f->last_land_us = F1 != GS_T_NONE ? F1 : T1;  /* (a fall's landing is the feet's, for the rebound's contact) */
+        f->last_land_us = F1 != GS_LT_NONE ? abs_of(f, F1) : T1_us;  /* (a fall's landing is the feet's, for the rebound's contact) */
         /* a body measured without a size: its flight is still a flight (its height unknown) */
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
 
-        if ((GS_WITH_POSE && c->fell) || (F1 != GS_T_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
+        if ((GS_WITH_POSE && c->fell) || (F1 != GS_LT_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
         else if (GS_WITH_POSE && c->feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;
-        else if (n_in < f->cfg->min_samples || T1 - T0 < f->min_flight_us)
+        else if (n_in < f->cfg->min_samples || T1_us - T0_us < f->min_flight_us)
             j->reason = GS_REJ_FEW_SAMPLES;
         else if (max_gap_in > f->max_gap_us)
             j->reason = GS_REJ_GAP;
@@ -1429,7 +1490,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         j->accepted = j->reason == GS_REJ_NONE;
         /* the same posture at both ends puts the COM at the same height (feet times only) */
         if (feet) {
-            gs_real du = fit_u_at(&fr, T1) - fit_u_at(&fr, T0);
+            gs_real du = fit_u_at(&fr, T1_us) - fit_u_at(&fr, T0_us);
             if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) j->warnings |= GS_WARN_COM_MISMATCH;
         }
 
@@ -1460,7 +1521,7 @@ done:
     return GS_CLOSE_NONE;
 }
 
-static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t);
+static void seed_found(gs_flight *f, uint32_t newest);
 
 /* Take the close's steps: all of them (all), else until one has run a robust fit or the
  * boundary search. */
@@ -1498,7 +1559,7 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
             spent = true;
             if (seed_core_width(f, c->apex, c->newest, seed_half_us[c->width])) {
                 c->stage = GS_CLOSE_NONE;
-                seed_found(f, c->newest, t_at(f, c->apex));  /* (its landing may begin a close) */
+                seed_found(f, c->newest);  /* (its landing may begin a close) */
                 stage = c->stage;
             } else if (++c->width == SEED_WIDTHS) {
                 stage = GS_CLOSE_NONE;
@@ -1639,9 +1700,9 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 
 /* The seed holds: airborne from its apex; samples after the core that arrived meanwhile
  * (through newest) are tested in order */
-static void seed_found(gs_flight *f, uint32_t newest, int64_t apex_t)
+static void seed_found(gs_flight *f, uint32_t newest)
 {
-    set_state(f, GS_FS_AIRBORNE, apex_t);
+    set_state(f, GS_FS_AIRBORNE, t_at(f, f->seed_idx));  /* (the apex: held, as the core around it) */
     for (uint32_t i = f->fl_last + 1; i <= newest && f->state == GS_FS_AIRBORNE; i++) {
         gs_sample_full p_b;
         const gs_sample_full *p = usable_at(f, i, &p_b);
@@ -1671,11 +1732,11 @@ static void job_wait(gs_flight *f, gs_close *c, int64_t t_us, uint32_t n_ground,
  * in the next frame (GS_CLOSE_SEED; at once when that frame could be a standing one, as it is
  * when the "apex" was a standing body's noise) */
 #define SEED_WIDTHS_NOW 2
-static void seed_begin(gs_flight *f, uint32_t apex, uint32_t newest, int64_t apex_t, int64_t t_us)
+static void seed_begin(gs_flight *f, uint32_t apex, uint32_t newest, int64_t t_us)
 {
     for (unsigned k = 0; k < SEED_WIDTHS_NOW; k++)
         if (seed_core_width(f, apex, newest, seed_half_us[k])) {
-            seed_found(f, newest, apex_t);
+            seed_found(f, newest);
             return;
         }
     gs_close *c = &f->close;
@@ -1708,8 +1769,9 @@ static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full
 #else
     const gs_sample_full *b = usable_at(f, idx - k, &b_b);
 #endif
-    if (!b || s->t_us <= b->t_us) return NAN;
-    return GS_FABSR(u - u_of(f, b)) / gs_time_span_s(s->t_us, b->t_us);
+    int32_t dt_us = b ? near_us(s->t_us, b->t_us) : 0;  /* (two held samples) */
+    if (dt_us <= 0) return NAN;
+    return GS_FABSR(u - u_of(f, b)) / gs_time_span32_s(dt_us);
 }
 
 /* keep size in a ring of the last GS_STAND_KEEP */
@@ -1852,23 +1914,22 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
     /* a peak counts once it rose thr above the recent minimum; the drop that
      * confirms it as an apex seeds a flight, however far it has fallen by then */
     if (!finite_r(f->peak_u)) {
-        if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; f->peak_t_us = tm; }
+        if (um - umin > thr) { f->peak_u = um; f->peak_idx = im; }
         return;
     }
-    if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; f->peak_t_us = tm; return; }
+    if (um > f->peak_u) { f->peak_u = um; f->peak_idx = im; return; }
     gs_real drop = SEED_DROP_NOISE * nz;
     if (GS_R(0.01) * sz > drop) drop = GS_R(0.01) * sz;
     if (f->peak_u - um <= drop) return;
     uint32_t apex = f->peak_idx;
-    int64_t apex_t = f->peak_t_us;
     f->peak_u = -INFINITY;
 #if GS_CLOSE_LAG_FRAMES > 0
     if (!f->trace) {
-        seed_begin(f, apex, idx, apex_t, s->t_us);
+        seed_begin(f, apex, idx, s->t_us);
         return;
     }
 #endif
-    if (seed_core(f, apex, idx)) seed_found(f, idx, apex_t);
+    if (seed_core(f, apex, idx)) seed_found(f, idx);
 }
 
 static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_full *s)
@@ -1907,7 +1968,8 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
     }
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
-    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(s->t_us, t_at(f, f->seed_idx), f->max_flight_us)) {
+    int32_t t = lt_of(f, s->t_us);
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(t, lt_at(f, f->seed_idx), f->max_flight_us)) {
         land(f, idx, GS_NO_IDX, s);
         return;
     }
@@ -1927,7 +1989,7 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    if (f->cusum > GS_R(0.0) && span_over(s->t_us, t_at(f, f->fl_last), f->landing_latency_us)) {
+    if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us)) {
         land(f, idx, idx, s);
         return;
     }
@@ -1987,6 +2049,7 @@ static void rebase(gs_flight *f)
 /* Examine the samples pushed since (each after its frame's feet) until a close is pending */
 static void examine(gs_flight *f)
 {
+    set_time_base(f);
     uint32_t head = idx_of(f, gs_ring_head(f->ring));
     uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
     if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */

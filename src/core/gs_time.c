@@ -1,6 +1,6 @@
 /* gs_time.c - microsecond times (gs_time.h): spans to seconds and back. */
 #ifdef __OPTIMIZE_SIZE__
-#define GS_TIME_DEFINE  /* gs_time_span_us's one out-of-line copy (gs_time.h) */
+#define GS_TIME_DEFINE  /* gs_time_span_us's and gs_time_span32_s's one out-of-line copies (gs_time.h) */
 #endif
 #include "gravscale/gs_time.h"
 
