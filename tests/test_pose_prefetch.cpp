@@ -3,7 +3,11 @@
 // N) gives exactly the output of the sequential loop (--prefetch 0), byte for
 // byte, events and trace, on real clips: the gym jump (tracked throughout) and
 // people walking (the detector runs again and again). And gs::Prefetch itself:
-// order, the end, an exception from the worker, stopping early.
+// order, the end, an exception from the worker, stopping early; gs::SideThread
+// (the census's detector beside the landmarks): a job runs while its caller
+// works, its exception comes back, the thread serves job after job.
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -11,6 +15,7 @@
 #include <string>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <thread>
 #include <vector>
 
 extern "C" {
@@ -19,6 +24,7 @@ extern "C" {
 
 #include "pose_blazepose.hpp"
 #include "prefetch.hpp"
+#include "side_thread.hpp"
 #include "gs_test_util.hpp"
 
 #ifndef GS_SHARED_DIR
@@ -158,10 +164,46 @@ static void test_people_walking_same_output_with_prefetch(void)
     same_output(clip, "--model lite", {2});
 }
 
+// a side job runs on another thread while the caller goes on: the job waits for a
+// flag only the caller sets (run in the caller's thread it would give up after 10 s)
+void test_side_thread_runs_beside_its_caller(void)
+{
+    gs::SideThread side;
+    for (int round = 0; round < 3; round++) {
+        std::atomic<bool> caller_done(false), job_saw_it(false);
+        std::thread::id job_thread;
+        side.start([&] {
+            job_thread = std::this_thread::get_id();
+            const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+            while (!caller_done && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+            job_saw_it = caller_done.load();
+        });
+        caller_done = true;
+        TEST_ASSERT_TRUE(side.finish() == nullptr);
+        TEST_ASSERT_TRUE(job_saw_it);
+        TEST_ASSERT_TRUE(job_thread != std::this_thread::get_id());
+    }
+    side.start([] { throw std::runtime_error("side job failed"); });
+    std::exception_ptr e = side.finish();
+    TEST_ASSERT_TRUE(e != nullptr);
+    bool rethrown = false;
+    try {
+        std::rethrow_exception(e);
+    } catch (const std::runtime_error &ex) {
+        rethrown = std::strcmp(ex.what(), "side job failed") == 0;
+    }
+    TEST_ASSERT_TRUE(rethrown);
+    int ran = 0;  // still serving after an exception
+    side.start([&] { ran++; });
+    TEST_ASSERT_TRUE(side.finish() == nullptr);
+    TEST_ASSERT_EQUAL_INT(1, ran);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_prefetch_order_end_and_errors);
+    RUN_TEST(test_side_thread_runs_beside_its_caller);
     RUN_TEST(test_gym_jump_same_output_with_prefetch);
     RUN_TEST(test_people_walking_same_output_with_prefetch);
     return UNITY_END();

@@ -31,12 +31,14 @@
 // byte for byte ("same").
 //
 // Stage columns, ms per frame of wall time spent in each: decode (FFmpeg via
-// OpenCV), net (the pose networks with their crop and blob; pose minus net is
-// the tracker's own work), scene (camera motion on background corners,
-// stabilised keypoints, scene facts), core (COM, core pipeline and emitting
-// the events). "net %" is the network's time over the loop's wall time: the
-// network's share of the sequential pipeline, or how busy the network thread
-// is with prefetch (near 100 %: the network is what limits the frame rate).
+// OpenCV), pose (the networks and the tracker), net (the pose networks with
+// their crop and blob, summed: a census runs the detector in a thread of its
+// own beside the landmark network, so net can exceed pose), scene (camera
+// motion on background corners, stabilised keypoints, scene facts), core
+// (COM, core pipeline and emitting the events). "net %" is pose over the
+// loop's wall time: the pose stage's share of the sequential pipeline, or how
+// busy the network thread is with prefetch (near 100 %: it is what limits the
+// frame rate).
 #include <sched.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -321,7 +323,7 @@ int main(int argc, char **argv)
                     std::printf("%-5s %9s %4d %3d %3d | %6.1f %6.1f %7.1f | %6.2f %6.1f %6.1f %6.1f %6.2f | %4.0f%% | %4.2f %4.2f %4.2f  %s\n",
                                 m.c_str(), res, c, static_cast<int>(jnum(t, "cv_threads")), pf, n / loop, n / best.wall_s,
                                 1e3 * best.cpu_s / n, jnum(t, "decode_ms"), jnum(t, "pose_ms"), net, jnum(t, "scene_ms"),
-                                jnum(t, "core_ms"), 100.0 * net * n / (1e3 * loop), best.load_before, best.load_after, best.others, same);
+                                jnum(t, "core_ms"), 100.0 * jnum(t, "pose_ms") * n / (1e3 * loop), best.load_before, best.load_after, best.others, same);
                     std::fflush(stdout);
                 }
             }

@@ -528,9 +528,10 @@ struct PersonFront {
 // GS_VIDEO_TIMES=FILE: where the frame loop's time went, one JSON line
 // appended to FILE (for tools/bench_pipeline; not part of the output): per
 // frame, the wall ms spent in each stage and the CPU ms of the thread that ran
-// it (OpenCV's and FFmpeg's helper threads not counted; the network's time
-// is the pose tracker's own det_ms + lm_ms, wall only); the process's CPU
-// time of the setup and of the loop.
+// it (OpenCV's and FFmpeg's helper threads and the census's detector thread
+// not counted; the network's time is the pose tracker's own det_ms + lm_ms,
+// wall only, the two overlapping at a census); the process's CPU time of the
+// setup and of the loop.
 struct LoopTimes {
     gs::StageClock decode, pose, network, scene, core, wait;
     double t0_ms = 0.0, loop0_ms = 0.0, cpu0_ms = 0.0, loop_cpu0_ms = 0.0;

@@ -409,6 +409,53 @@ __attribute__((target("avx2"))) int above_avx2(const float *E, int x0, int x1, f
 }
 #endif
 
+// the largest of best and each E[x], x in [x0, w), where M[x] != 0 (M null: every x)
+float row_max_scalar(const float *E, const uchar *M, int x0, int w, float best)
+{
+    for (int x = x0; x < w; x++)
+        if ((!M || M[x]) && E[x] > best) best = E[x];
+    return best;
+}
+
+#ifdef GS_EIGEN_AVX2
+__attribute__((target("avx2"))) float row_max_avx2(const float *E, const uchar *M, int w, float best)
+{
+    __m256 acc = _mm256_set1_ps(best);
+    int x = 0;
+    for (; x + 8 <= w; x += 8) {
+        __m256 v = _mm256_loadu_ps(E + x);
+        if (M) {  // lanes outside the mask keep the maximum so far
+            const __m256i m = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i *>(M + x)));
+            v = _mm256_blendv_ps(v, acc, _mm256_castsi256_ps(_mm256_cmpeq_epi32(m, _mm256_setzero_si256())));
+        }
+        acc = _mm256_max_ps(acc, v);
+    }
+    float lanes[8];
+    _mm256_storeu_ps(lanes, acc);
+    for (float l : lanes) best = std::max(best, l);
+    return row_max_scalar(E, M, x, w, best);
+}
+#endif
+
+// cv::minMaxLoc(eig, nullptr, &max, nullptr, nullptr, mask)'s maximum: the largest
+// eigenvalue under the mask, 0 when the mask is empty
+double masked_max(const cv::Mat &eig, const cv::Mat &mask)
+{
+    float best = -FLT_MAX;
+    for (int y = 0; y < eig.rows; y++) {
+        const float *E = eig.ptr<float>(y);
+        const uchar *M = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+#ifdef GS_EIGEN_AVX2
+        if (have_avx2()) {
+            best = row_max_avx2(E, M, eig.cols, best);
+            continue;
+        }
+#endif
+        best = row_max_scalar(E, M, 0, eig.cols, best);
+    }
+    return best == -FLT_MAX ? 0.0 : best;
+}
+
 // cv::cornerMinEigenVal(src, eig, block, 3, BORDER_DEFAULT) with the same floats:
 // OpenCV's Sobel, then the products' unnormalised box sums (double, BORDER_REFLECT_101)
 // and the smaller eigenvalue of each 2x2 sum
@@ -487,8 +534,7 @@ void good_features(const cv::Mat &img, std::vector<cv::Point2f> &corners, int ma
     corners.clear();
     min_eigen(img, block, wk);
     const cv::Mat &eig = wk.eig;
-    double max_val = 0.0;
-    cv::minMaxLoc(eig, nullptr, &max_val, nullptr, nullptr, mask);
+    const double max_val = masked_max(eig, mask);
     const float thr = static_cast<float>(max_val * quality);
     const int w = img.cols, h = img.rows;
     // local maxima of the image thresholded to zero (cv::threshold, cv::dilate 3x3), inside the border

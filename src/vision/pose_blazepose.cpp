@@ -14,6 +14,7 @@
 
 #include "camera_motion.hpp"
 #include "pose_look.hpp"
+#include "side_thread.hpp"
 #include "warp_crop.hpp"
 
 #include <opencv2/dnn.hpp>
@@ -552,6 +553,7 @@ struct PoseTracker::Impl {
     double last_census_t = -1e300;     // time of the detector's last run
     PoseLook look;                     // the kept person's colours per body part
     double drift_r = 0.1;              // tracked vs fresh landmarks further apart than this x r: the ROI slid
+    SideThread census_side;            // the census's detector beside the tracked ROI's landmarks
 
     bool process(const cv::Mat &bgr, double t_s, PoseOutput *out);
     bool process_plain(const cv::Mat &bgr, double t_s, PoseOutput *out);
@@ -918,15 +920,33 @@ bool PoseTracker::Impl::process_keep(const cv::Mat &bgr, double t_s, PoseOutput 
         return true;
     };
     bool lm_ok = false;
+    std::vector<PoseDetection> dets;
+    bool detected = false;
+    double det_ms = 0.0;
     if (tracking) {
-        lm_ok = run_lm(roi);
-        bool census_due = crowded || t_s - last_census_t >= cfg.recheck_s || t_s < last_census_t;
-        if (lm_ok && !census_due && (!keeper.has() || keeper.plausible(body))) return accept(false);
+        const bool census_due = crowded || t_s - last_census_t >= cfg.recheck_s || t_s < last_census_t;
+        if (census_due) {  // the census's detector (the same frame either way) beside the landmarks
+            census_side.start([&] {
+                const double t0 = now_ms();
+                dets = detect(bgr);
+                det_ms = now_ms() - t0;
+            });
+            SideJob job(census_side);
+            lm_ok = run_lm(roi);
+            job.rethrow();
+            detected = true;
+        } else {
+            lm_ok = run_lm(roi);
+            if (lm_ok && (!keeper.has() || keeper.plausible(body))) return accept(false);
+        }
     }
     // the census: who is where
-    double t0 = now_ms();
-    std::vector<PoseDetection> dets = detect(bgr);
-    out->det_ms += now_ms() - t0;
+    if (!detected) {
+        const double t0 = now_ms();
+        dets = detect(bgr);
+        det_ms = now_ms() - t0;
+    }
+    out->det_ms += det_ms;
     out->detector_ran = true;
     out->persons = static_cast<int>(dets.size());
     last_census_t = t_s;

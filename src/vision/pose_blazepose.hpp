@@ -11,7 +11,8 @@
 // lost frame is retried with the detector at once, so no frame is skipped.
 // One person is kept (keep_person, docs/pose.md "One person"): the detector
 // re-checks every recheck_s (every frame while someone else is near, or when
-// the landmarks jump beyond what a body can do); a re-detection takes the
+// the landmarks jump beyond what a body can do), in a thread of its own beside
+// the tracked ROI's landmarks (side_thread.hpp); a re-detection takes the
 // person that matches the tracked one (PoseKeeper), not the most confident;
 // body parts whose colours are not the person's (PoseLook, pose_look.hpp) give
 // c = 0, and a trunk that is not the person's gives no pose that frame.
@@ -213,7 +214,7 @@ struct PoseOutput {
     int covered = 0;           // bits (1 << PoseLookPart) of parts not the kept person's colours: their keypoints c = 0
     bool rejected = false;     // landmarks were found but judged not the tracked person's (someone
                                // else, or a body that cannot be there): present = false
-    double det_ms = 0.0;       // this frame's detector time (pre- and post-processing included)
+    double det_ms = 0.0;       // this frame's detector time (pre- and post-processing included; at a census beside lm_ms)
     double lm_ms = 0.0;        // this frame's landmark time
 };
 
