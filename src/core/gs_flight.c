@@ -112,7 +112,7 @@ static inline __attribute__((always_inline)) int32_t lt_of(const gs_flight *f, i
 }
 
 /* ... and the absolute time of a local one */
-static int64_t abs_of(const gs_flight *f, int32_t t_lus) { return f->tb_us + t_lus; }
+static NOINLINE int64_t abs_of(const gs_flight *f, int32_t t_lus) { return f->tb_us + t_lus; }
 
 /* local time of ring sample i (the packed field is its low word), GS_LT_NONE when not held */
 static int32_t lt_at(const gs_flight *f, uint32_t i)
@@ -1185,20 +1185,22 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t
 /* The boundary time on one side (GS_T_NONE: unknown) from the flight's edge and the contact
  * samples past it (those end where contact was detected, alarm: further out the ground
  * phase is no longer a constant force); *outer = the outermost contact sample. */
-static int32_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool alarm,
-                            uint32_t edge, uint32_t other_edge, bool refine, gs_real pen,
-                            uint32_t *outer)
+static int32_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool refine, uint32_t *outer)
 {
     const gs_fit_result *r = &c->r;
+    uint32_t edge = side < 0 ? f->fl_first : f->fl_last, other_edge = side < 0 ? f->fl_last : f->fl_first;
+    bool alarm = (side < 0 ? c->left_alarm : c->right_alarm) != GS_NO_IDX;
     uint32_t first = edge;  /* the first contact sample */
     *outer = edge;
     if (!refine) return GS_LT_NONE;
     uint32_t n = alarm ? contact_run(f, r, edge, side, c->head, outer, &first) : 0;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
-    if (n >= 2)
+    if (n >= 2) {
+        gs_real sig = fit_sigma(f, r);
         return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
-                               side, edge, *outer, pen, r);
+                               side, edge, *outer, DROP_PENALTY * sig * sig, r);
+    }
     if (n == 1) {
         int32_t t_first = lt_at(f, first), t_edge = lt_at(f, edge);  /* both held: L is */
         return t_edge + (t_first - t_edge) / 2;
@@ -1336,11 +1338,9 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
     bool feet = GS_WITH_POSE && c->F0_lus != GS_LT_NONE && c->F1_lus != GS_LT_NONE;
     if (GS_WITH_POSE) c->feet = feet;
     bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
-    gs_real sig = fit_sigma(f, r);
-    gs_real pen = DROP_PENALTY * sig * sig;
     uint32_t lo, hi;  /* the outermost contact samples */
-    int32_t T0 = c->T0_lus = boundary_time(f, c, -1, c->left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
-    int32_t T1 = c->T1_lus = boundary_time(f, c, +1, c->right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
+    int32_t T0 = c->T0_lus = boundary_time(f, c, -1, refine, &lo);
+    int32_t T1 = c->T1_lus = boundary_time(f, c, +1, refine, &hi);
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         (long long)T0, (long long)T1, r->a_px_s2);
@@ -1422,6 +1422,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
+    uint32_t warn = 0;  /* j->warnings, set once */
 
     {
         gs_real g = f->g_m_s2;
@@ -1444,11 +1445,11 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             j->contact_time_s = gs_time_span_s(T0_us, f->last_land_us);
             j->rsi = j->jump_height_m / j->contact_time_s;
         }
-        if (!IS_RIGID(f) && !feet) j->warnings |= GS_WARN_COM_TIMED;
+        if (!IS_RIGID(f) && !feet) warn |= GS_WARN_COM_TIMED;
         /* the stature only where the body stood at the flight's place (its feet on the same floor row) */
         if (feet && f->feet.epoch == f->stand_floor_epoch && finite_r(f->stand_floor_px) &&
             finite_r(c->floor_off_px) && GS_FABSR((gs_real)(c->floor_off_px - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
-            j->warnings |= GS_WARN_DEPTH_CHANGED;
+            warn |= GS_WARN_DEPTH_CHANGED;
             size = size_se = NAN;
             j->size_px = NAN;
         }
@@ -1467,7 +1468,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         f->last_land_us = F1 != GS_LT_NONE ? abs_of(f, F1) : T1_us;  /* (a fall's landing is the feet's, for the rebound's contact) */
         /* a body measured without a size: its flight is still a flight (its height unknown) */
         bool sizeless_ok = !IS_RIGID(f) && feet;
-        if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
+        if (!finite_r(size) && sizeless_ok && !(warn & GS_WARN_DEPTH_CHANGED)) warn |= GS_WARN_NO_SIZE;
 
         if ((GS_WITH_POSE && c->fell) || (F1 != GS_LT_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
@@ -1491,14 +1492,15 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         /* the same posture at both ends puts the COM at the same height (feet times only) */
         if (feet) {
             gs_real du = fit_u_at(&fr, T1_us) - fit_u_at(&fr, T0_us);
-            if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) j->warnings |= GS_WARN_COM_MISMATCH;
+            if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) warn |= GS_WARN_COM_MISMATCH;
         }
 
-        if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
-        if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
-        if (c->truncated) j->warnings |= GS_WARN_CLIPPED;
+        if (n_in < 2u * f->cfg->min_samples) warn |= GS_WARN_FEW_SAMPLES;
+        if (n_out * 5u > n_in) warn |= GS_WARN_OUTLIERS;
+        if (c->truncated) warn |= GS_WARN_CLIPPED;
         if (GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))  /* (NaN before an accepted flight) */
-            j->warnings |= GS_WARN_GRAVITY_TILT;
+            warn |= GS_WARN_GRAVITY_TILT;
+        j->warnings = warn;
     }
 
     if (j->accepted) {
@@ -1962,46 +1964,40 @@ static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_ful
 
 static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 {
+    uint32_t alarm = GS_NO_IDX;  /* the landing's contact alarm (one call of land below) */
     if (f->feet_wait_us != GS_T_NONE) {  /* the COM landed: waiting for the feet */
-        if (s->t_us >= f->feet_wait_us || !gs_feet_airborne(&f->feet)) land(f, idx, f->wait_alarm, s);
-        return;
+        if (s->t_us < f->feet_wait_us && gs_feet_airborne(&f->feet)) return;
+        alarm = f->wait_alarm;
+        goto landed;
     }
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
     int32_t t = lt_of(f, s->t_us);
-    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(t, lt_at(f, f->seed_idx), f->max_flight_us)) {
-        land(f, idx, GS_NO_IDX, s);
-        return;
-    }
-    if (r.n >= 8 && !plausible_fall(f, &r, gate_size(f, idx))) {  /* a standing phase, not a flight */
-        land(f, idx, GS_NO_IDX, s);
-        return;
-    }
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(t, lt_at(f, f->seed_idx), f->max_flight_us))
+        goto landed;
+    if (r.n >= 8 && !plausible_fall(f, &r, gate_size(f, idx)))  /* a standing phase, not a flight */
+        goto landed;
     uint32_t k = idx - f->fl_last - 1;  /* position among the pending samples */
-    if (k >= 32) { land(f, idx, GS_NO_IDX, s); return; }
+    if (k >= 32) goto landed;
     gs_real z;
     bool ok = test_sample(f, &r, s, &z);
     DBG("t=%lld ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", (long long)s->t_us, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
-        if (++f->outliers_run >= 3) land(f, idx, GS_NO_IDX, s);
+        if (++f->outliers_run >= 3) goto landed;
         return;
     }
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
+    alarm = idx;
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us)) {
-        land(f, idx, idx, s);
-        return;
-    }
+    if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us))
+        goto landed;
     if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
         fit_memo m = {0};
-        if (alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) {
-            f->fl_last = idx;   /* the refit took every sample through idx */
-            f->cusum = GS_R(0.0);
-            f->pend_ok = 0;
-            return;
-        }
-        land(f, idx, idx, s);
+        if (!alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) goto landed;
+        f->fl_last = idx;   /* the refit took every sample through idx */
+        f->cusum = GS_R(0.0);
+        f->pend_ok = 0;
         return;
     }
     f->pend_ok |= 1u << k;
@@ -2016,6 +2012,9 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
         f->fl_last = idx;
         f->pend_ok = 0;
     }
+    return;
+landed:
+    land(f, idx, alarm, s);
 }
 
 /* Keep the offsets small: once the ring's head is 2 x GS_FLIGHT_IDX_KEEP past the base,
