@@ -188,6 +188,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float d = ft->delta_rel * size_px;
     bool stop_touch = !RECROSS || ft->stop_touch;
     if (!fin(u)) return;  /* a missing frame changes nothing */
+    float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);  /* (nothing below changes the history) */
     /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */
     float margin = MARGIN_REL * size_px;
     if (NOISE_K * f->noise_px > margin) margin = NOISE_K * f->noise_px;
@@ -200,7 +201,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
             f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
             f->lifted = f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
             f->touch_unsure = 0;
-        } else if (f->touch_unsure == 1 || !(speed(ft, f, 0) < 0.0f)) {
+        } else if (f->touch_unsure == 1 || !(v2 < 0.0f)) {
             f->touch_unsure = 0;
         }
     }
@@ -219,7 +220,6 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     f->lift_pending = f->armed && above;
     /* a touch by the stop: falling fast, then (nearly) stopped by the floor (for ankles only
      * well below the level they left: a lower floor) */
-    float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);
     /* the floor slows the point at once (a heel comes down at well under a stature per second); in the air it falls on */
     f->falling = v2 < -FALL_REL * size_px;
     float vf = speed(ft, f, 2);  /* (the impact may fall inside the last falling interval) */

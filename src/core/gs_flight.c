@@ -334,9 +334,17 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->on_event = on_event;
     f->ctx = ctx;
     f->g_m_s2 = gs_core_config_g(cfg);
-    if (!span_cfg_us(cfg->min_flight_s, &f->min_flight_us) || !span_cfg_us(cfg->max_flight_s, &f->max_flight_us) ||
-        !span_cfg_us(cfg->max_gap_s, &f->max_gap_us) || !span_cfg_us(cfg->landing_latency_s, &f->landing_latency_us))
-        return GS_EINVAL;
+    /* the configured spans into f's four span fields, in turn */
+    static const uint8_t span_cfg[4] = {offsetof(gs_core_config, min_flight_s), offsetof(gs_core_config, max_flight_s),
+                                        offsetof(gs_core_config, max_gap_s), offsetof(gs_core_config, landing_latency_s)};
+    _Static_assert(offsetof(gs_flight, max_flight_us) == offsetof(gs_flight, min_flight_us) + 4 &&
+                   offsetof(gs_flight, max_gap_us) == offsetof(gs_flight, min_flight_us) + 8 &&
+                   offsetof(gs_flight, landing_latency_us) == offsetof(gs_flight, min_flight_us) + 12,
+                   "the span fields follow each other");
+    for (unsigned k = 0; k < 4; k++)
+        if (!span_cfg_us(*(const float *)(const void *)((const char *)cfg + span_cfg[k]),
+                         (int32_t *)(void *)((char *)f + offsetof(gs_flight, min_flight_us) + 4u * k)))
+            return GS_EINVAL;
     uint64_t head = gs_ring_head(ring);
     f->base = head > GS_FLIGHT_IDX_KEEP ? head - GS_FLIGHT_IDX_KEEP : 0u;
     f->next = idx_of(f, head);
