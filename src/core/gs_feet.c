@@ -207,9 +207,10 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     }
     /* a lift: it rested, and rose clearly past its level plus delta in two frames running
      * (one is an outlier) */
-    bool above = u > f->rest_px + d + margin;
+    float lift_px = f->rest_px + d;  /* the lift level */
+    bool above = u > lift_px + margin;
     if (f->armed && above && f->lift_pending) {
-        int64_t tc = crossing_us(ft, f, f->rest_px + d, true);
+        int64_t tc = crossing_us(ft, f, lift_px, true);
         if (tc != GS_T_NONE) {
             log_event(f->lift, tc, f->rest_px, NAN);
             f->lifted = 1;
@@ -234,8 +235,9 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         }
     }
     /* a touch by the recrossing (ankles): back down through the level it left, plus delta */
-    if (RECROSS && !stop_touch && f->lifted && u <= f->floor_px + d) {
-        int64_t tc = crossing_us(ft, f, f->floor_px + d, false);
+    float back_px = f->floor_px + d;  /* (the recrossing's level) */
+    if (RECROSS && !stop_touch && f->lifted && u <= back_px) {
+        int64_t tc = crossing_us(ft, f, back_px, false);
         if (tc != GS_T_NONE) {
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
@@ -269,7 +271,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     }
     uint32_t need_us = f->rest_px > f->floor_px + d + GS_FEET_SINK_REL * size_px ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
     bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
-    f->armed = (rested && m <= f->rest_px + d) || (f->armed && (u <= f->rest_px + d + margin || f->lift_pending));
+    lift_px = f->rest_px + d;  /* (the level as it is now) */
+    f->armed = (rested && m <= lift_px) || (f->armed && (u <= lift_px + margin || f->lift_pending));
     if (f->armed) f->floor_px = f->rest_px;
     if (m < f->floor_px - d - GS_FEET_SINK_REL * size_px) f->sank_us = t_us;  /* (an ankle may rest delta up, on its toes) */
     /* on the floor: still there, or (toes) not yet risen clear of it since; the run of such frames */

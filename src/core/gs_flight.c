@@ -1262,7 +1262,7 @@ static NOINLINE void restart_levels(gs_flight *f, uint32_t i)
 /* The close is over: the next flight may start right after this landing (land_idx: the
  * first sample after the flight, GS_NO_IDX unknown), its take-off side must see the
  * contact samples that follow it */
-static void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
+static NOINLINE void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
 {
     f->quiet_from = land_idx < c->newest ? land_idx : c->newest;  /* (GS_NO_IDX is above every index) */
     restart_levels(f, c->newest);  /* next seeds start after the landing */
@@ -1310,10 +1310,12 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
-        if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
+        bool known = apex_us != GS_T_NONE && c0 != GS_T_NONE;
+        int64_t c0_from = known ? c0 - FEET_BEFORE_COM_US : 0;  /* the feet's events count from here */
+        if (known && c1 != GS_T_NONE) {
 
             /* (both within the local range: near the flight's held samples) */
-            int64_t F0_us = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &c->floor_off_px);
+            int64_t F0_us = gs_feet_takeoff(&f->feet, c0_from, apex_us, &c->floor_off_px);
             int64_t from = c1 - FEET_BEFORE_COM_US > apex_us ? c1 - FEET_BEFORE_COM_US : apex_us;
             int64_t F1_us = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &c->floor_on_px, &c->floor_before_px);
             c->F0_lus = F0_us != GS_T_NONE ? lt_of(f, F0_us) : GS_LT_NONE;
@@ -1327,7 +1329,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
          * rested, as in quick hops, say nothing: the COM times the flight) */
-        if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
+        if (known && gs_feet_seen_since(&f->feet, c0_from))
             c->feet_contradict = gs_feet_resting_at(&f->feet, apex_us) ||
                               (F0 != GS_LT_NONE && F1 == GS_LT_NONE && gs_feet_airborne(&f->feet));
         /* a fall: the feet went well below the floor they left (a box): after a clean take-off
@@ -1533,15 +1535,31 @@ done:
 
 static void seed_found(gs_flight *f, uint32_t newest);
 
+#if GS_CLOSE_LAG_FRAMES == 0
+/* Without a lag (the firmware) every close runs whole: its steps in order, no stage kept */
+static void close_run(gs_flight *f, gs_close *c, bool all)
+{
+    fit_memo memo = {0}, *m = &memo;
+    bool spent;  /* (every step runs: unused) */
+    (void)all;
+    gs_fit_result r;
+    if (c->stage == GS_CLOSE_REFIT) refit_range(f, m, f->fl_first, f->fl_last, &r);
+    uint8_t stage = close_start(f, c);
+    while (stage == GS_CLOSE_GROW) stage = grow_left_step(f, c, m, true, &spent);
+    if (stage == GS_CLOSE_GROWN) {
+        f->fl_first = c->clean;
+        if (refit_range(f, m, f->fl_first, f->fl_last, &r)) gs_fit_solve(&f->fit, &c->r);
+        stage = GS_CLOSE_BOUNDS;
+    }
+    if (stage == GS_CLOSE_BOUNDS) { close_bounds(f, c); close_final(f, c, m); }
+    c->stage = GS_CLOSE_NONE;
+}
+#else
 /* Take the close's steps: all of them (all), else until one has run a robust fit or the
  * boundary search. */
 static void close_run(gs_flight *f, gs_close *c, bool all)
 {
-#if GS_CLOSE_LAG_FRAMES > 0
     fit_memo *m = &c->memo;
-#else
-    fit_memo memo = {0}, *m = &memo;  /* (every step in this call) */
-#endif
     bool spent = false;
     uint8_t stage = c->stage;
     while (stage != GS_CLOSE_NONE && (all || !spent)) {
@@ -1581,6 +1599,8 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
     }
     c->stage = stage;
 }
+
+#endif
 
 /* Begin closing the open candidate. right_alarm: the sample at which contact was
  * detected after the flight (GS_NO_IDX when it ended otherwise); refit: rebuild the
@@ -1866,9 +1886,11 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 {
     /* history for the median of three and second differences */
     if (f->n_hist == 3) {
-        f->u_hist[0] = f->u_hist[1]; f->u_hist[1] = f->u_hist[2];
-        f->i_hist[0] = f->i_hist[1]; f->i_hist[1] = f->i_hist[2];
-        f->t_hist_us[0] = f->t_hist_us[1]; f->t_hist_us[1] = f->t_hist_us[2];
+        for (unsigned k = 0; k < 2; k++) {
+            f->u_hist[k] = f->u_hist[k + 1];
+            f->i_hist[k] = f->i_hist[k + 1];
+            f->t_hist_us[k] = f->t_hist_us[k + 1];
+        }
         f->n_hist = 2;
     }
     f->u_hist[f->n_hist] = u_of(f, s);
