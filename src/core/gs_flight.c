@@ -34,6 +34,7 @@
 #define DBG(...) ((void)0)
 #endif
 
+#include "gs_finite.h"
 #include "gs_inline.h"
 #include "gs_median.h"
 #include "gs_select.h"
@@ -88,7 +89,7 @@
 #define GRAV_DIR_MIN_DEG GS_R(8.0)    /* ... plus this (a standing body's axis leans a few degrees, most seen from the side) */
 
 /* isfinite of a gs_real (or float) value, in one place */
-static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
+static NOINLINE bool finite_r(gs_real x) { return gs_finite_r(x); }
 
 
 /* The flight's sample indices are 32-bit offsets from f->base (64-bit compares and
