@@ -420,7 +420,7 @@ static inline uint32_t mod_by(uint32_t a, uint64_t magic, uint32_t n)
 static bool sample_usable(const gs_sample *s)
 {
     /* w_q > 0 is gs_sample_w(s) > 0 without the division */
-    return s->w_q > 0u && gs_finite_f(s->x_px) && gs_finite_f(s->y_px);
+    return s->w_q > 0u && gs_finite2_f(s->x_px, s->y_px);
 }
 
 /* Window sample i unpacked into *out when it is held and usable; false otherwise. */

@@ -133,7 +133,7 @@ static int64_t t_at(const gs_flight *f, uint32_t i)
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px);
+    return s && s->w >= USABLE_W_MIN && gs_finite2_f(s->x_px, s->y_px);
 }
 
 static bool held(const gs_flight *f, uint32_t i) { return gs_ring_at(f->ring, ring_idx(f, i)) != NULL; }
@@ -1840,7 +1840,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_us = s->t_us;
     /* body axis -> image up, until flights measure gravity directly */
-    if (!f->up_from_flight && finite_r(s->up_x) && finite_r(s->up_y)) {
+    if (!f->up_from_flight && gs_finite2_f(s->up_x, s->up_y)) {
         gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
         gs_real ux = (GS_R(1.0) - kw) * f->up_x + kw * (gs_real)s->up_x;
         gs_real uy = (GS_R(1.0) - kw) * f->up_y + kw * (gs_real)s->up_y;
