@@ -375,9 +375,11 @@ int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float
             if (e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
                 best = e;
         }
-    if (level_px) *level_px = best ? best->level_px : NAN;
-    if (before_px) *before_px = best ? best->from_px : NAN;
-    return best ? best->t_us : GS_T_NONE;
+    static const gs_feet_event none = {GS_T_NONE, NAN, NAN};
+    if (!best) best = &none;
+    if (level_px) *level_px = best->level_px;
+    if (before_px) *before_px = best->from_px;
+    return best->t_us;
 }
 
 bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us)
