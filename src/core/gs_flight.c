@@ -1451,8 +1451,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         j->takeoff_velocity_m_s = g * rise_t;
         /* a rebound: the ground contact since the last landing, no stance between */
         j->contact_time_s = j->rsi = NAN;
-        /* (0 < T0 - last <= CONTACT_MAX_US in one unsigned test: no last landing, GS_T_NONE, is
-         * 2^62 us or more before any T0) */
+        /* 0 < T0 - last <= CONTACT_MAX_US unsigned: GS_T_NONE lies 2^62 us or more before any T0 */
         if ((uint64_t)T0_us - (uint64_t)f->last_land_us - 1u < (uint64_t)CONTACT_MAX_US &&
             !(f->stand_last_us > f->last_land_us)) {
             j->contact_time_s = gs_time_span_s(T0_us, f->last_land_us);
