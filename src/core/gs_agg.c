@@ -174,10 +174,11 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
     gs_real rms_se = n_se > 0 ? GS_SQRT(se2_sum / n_se) : (gs_real)NAN;
 
     gs_real half;
+    /* the fits' SEs, 0 when none is known */
+    gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
     if (n == 1) {
         gs_real tau = SINGLE_FLIGHT_REL_SPREAD * med;
-        gs_real se = isnan(rms_se) ? GS_R(0.0) : rms_se;
-        half = GS_R(1.96) * GS_SQRT(se * se + tau * tau);
+        half = GS_R(1.96) * GS_SQRT(se_floor * se_floor + tau * tau);
     } else {
         /* Between-flight spread: MAD, scaled to a normal sigma, small-sample corrected. */
 #ifdef __OPTIMIZE_SIZE__
@@ -191,7 +192,6 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         gs_real corr = n < 10 ? k_mad_corr[n] : (gs_real)n / ((gs_real)n - GS_R(0.8));
         gs_real spread = MAD_TO_SIGMA * mad * corr;
         /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
-        gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
         gs_real sigma = spread > se_floor ? spread : se_floor;
         /* Satterthwaite: only the part of sigma^2 beyond the known SEs is estimated
          * from the n flights (n-1 dof); all of it known -> normal quantile. */

@@ -688,7 +688,7 @@ static void com_result(const frame *f, float total, gs_com_out *out)
      * out of the frame at the apex) biases the renormalised COM by centimetres:
      * such frames count only when nothing better exists */
     if (f->com.w < 0.999f * total) w *= DROPPED_SEGMENT_WEIGHT;
-    if (gs_finite_f(com.x) && gs_finite_f(com.y)) {
+    if (gs_finite2_f(com.x, com.y)) {
         out->x_px = com.x;
         out->y_px = com.y;
         out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
@@ -711,7 +711,7 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     if (gs_finite_f(st)) { /* else NaN: absurd coordinates overflow float */
         out->stature_px = st;
     }
-    if (!gs_finite_f(up.x) || !gs_finite_f(up.y)) {
+    if (!gs_finite2_f(up.x, up.y)) {
         up = (vec2){ NAN, NAN };
         axis_from_body = false;
     }

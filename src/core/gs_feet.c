@@ -188,6 +188,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float d = ft->delta_rel * size_px;
     bool stop_touch = !RECROSS || ft->stop_touch;
     if (!fin(u)) return;  /* a missing frame changes nothing */
+    float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);  /* (nothing below changes the history) */
     /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */
     float margin = MARGIN_REL * size_px;
     if (NOISE_K * f->noise_px > margin) margin = NOISE_K * f->noise_px;
@@ -200,15 +201,16 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
             f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
             f->lifted = f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
             f->touch_unsure = 0;
-        } else if (f->touch_unsure == 1 || !(speed(ft, f, 0) < 0.0f)) {
+        } else if (f->touch_unsure == 1 || !(v2 < 0.0f)) {
             f->touch_unsure = 0;
         }
     }
     /* a lift: it rested, and rose clearly past its level plus delta in two frames running
      * (one is an outlier) */
-    bool above = u > f->rest_px + d + margin;
+    float lift_px = f->rest_px + d;  /* the lift level */
+    bool above = u > lift_px + margin;
     if (f->armed && above && f->lift_pending) {
-        int64_t tc = crossing_us(ft, f, f->rest_px + d, true);
+        int64_t tc = crossing_us(ft, f, lift_px, true);
         if (tc != GS_T_NONE) {
             log_event(f->lift, tc, f->rest_px, NAN);
             f->lifted = 1;
@@ -219,7 +221,6 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     f->lift_pending = f->armed && above;
     /* a touch by the stop: falling fast, then (nearly) stopped by the floor (for ankles only
      * well below the level they left: a lower floor) */
-    float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);
     /* the floor slows the point at once (a heel comes down at well under a stature per second); in the air it falls on */
     f->falling = v2 < -FALL_REL * size_px;
     float vf = speed(ft, f, 2);  /* (the impact may fall inside the last falling interval) */
@@ -234,8 +235,9 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         }
     }
     /* a touch by the recrossing (ankles): back down through the level it left, plus delta */
-    if (RECROSS && !stop_touch && f->lifted && u <= f->floor_px + d) {
-        int64_t tc = crossing_us(ft, f, f->floor_px + d, false);
+    float back_px = f->floor_px + d;  /* (the recrossing's level) */
+    if (RECROSS && !stop_touch && f->lifted && u <= back_px) {
+        int64_t tc = crossing_us(ft, f, back_px, false);
         if (tc != GS_T_NONE) {
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
@@ -269,7 +271,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     }
     uint32_t need_us = f->rest_px > f->floor_px + d + GS_FEET_SINK_REL * size_px ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
     bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
-    f->armed = (rested && m <= f->rest_px + d) || (f->armed && (u <= f->rest_px + d + margin || f->lift_pending));
+    lift_px = f->rest_px + d;  /* (the level as it is now) */
+    f->armed = (rested && m <= lift_px) || (f->armed && (u <= lift_px + margin || f->lift_pending));
     if (f->armed) f->floor_px = f->rest_px;
     if (m < f->floor_px - d - GS_FEET_SINK_REL * size_px) f->sank_us = t_us;  /* (an ankle may rest delta up, on its toes) */
     /* on the floor: still there, or (toes) not yet risen clear of it since; the run of such frames */
@@ -372,9 +375,11 @@ int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float
             if (e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
                 best = e;
         }
-    if (level_px) *level_px = best ? best->level_px : NAN;
-    if (before_px) *before_px = best ? best->from_px : NAN;
-    return best ? best->t_us : GS_T_NONE;
+    static const gs_feet_event none = {GS_T_NONE, NAN, NAN};
+    if (!best) best = &none;
+    if (level_px) *level_px = best->level_px;
+    if (before_px) *before_px = best->from_px;
+    return best->t_us;
 }
 
 bool gs_feet_resting_at(const gs_feet *ft, int64_t t_us)

@@ -161,7 +161,7 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
 
 void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
 {
-    if (!f || !(w > GS_R(0.0)) || !isfinite(w) || !gs_time_ok(t_us) || !isfinite(x_px) || !isfinite(y_px)) {
+    if (!f || !(w > GS_R(0.0)) || !gs_finite_r(w) || !gs_time_ok(t_us) || !gs_finite_r(x_px) || !gs_finite_r(y_px)) {
         return;
     }
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
@@ -210,7 +210,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
     for (k = 0; k < 3; k++) {
         gs_real d = fabs(f->r[rix(k, k)]);
-        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
+        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !gs_finite_r(d)) {
             return GS_EINVAL;
         }
     }
@@ -420,7 +420,7 @@ static inline uint32_t mod_by(uint32_t a, uint64_t magic, uint32_t n)
 static bool sample_usable(const gs_sample *s)
 {
     /* w_q > 0 is gs_sample_w(s) > 0 without the division */
-    return s->w_q > 0u && gs_finite_f(s->x_px) && gs_finite_f(s->y_px);
+    return s->w_q > 0u && gs_finite2_f(s->x_px, s->y_px);
 }
 
 /* Window sample i unpacked into *out when it is held and usable; false otherwise. */
@@ -510,7 +510,7 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
         p->c[3 * axis + 2] = c2;
     }
     for (k = 0; k < 6; k++) {
-        if (!isfinite(p->c[k])) {
+        if (!gs_finite_r(p->c[k])) {
             return false;
         }
     }

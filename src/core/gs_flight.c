@@ -34,6 +34,7 @@
 #define DBG(...) ((void)0)
 #endif
 
+#include "gs_finite.h"
 #include "gs_inline.h"
 #include "gs_median.h"
 #include "gs_select.h"
@@ -88,7 +89,7 @@
 #define GRAV_DIR_MIN_DEG GS_R(8.0)    /* ... plus this (a standing body's axis leans a few degrees, most seen from the side) */
 
 /* isfinite of a gs_real (or float) value, in one place */
-static NOINLINE bool finite_r(gs_real x) { return isfinite(x); }
+static NOINLINE bool finite_r(gs_real x) { return gs_finite_r(x); }
 
 
 /* The flight's sample indices are 32-bit offsets from f->base (64-bit compares and
@@ -112,7 +113,7 @@ static inline __attribute__((always_inline)) int32_t lt_of(const gs_flight *f, i
 }
 
 /* ... and the absolute time of a local one */
-static int64_t abs_of(const gs_flight *f, int32_t t_lus) { return f->tb_us + t_lus; }
+static NOINLINE int64_t abs_of(const gs_flight *f, int32_t t_lus) { return f->tb_us + t_lus; }
 
 /* local time of ring sample i (the packed field is its low word), GS_LT_NONE when not held */
 static int32_t lt_at(const gs_flight *f, uint32_t i)
@@ -132,7 +133,7 @@ static int64_t t_at(const gs_flight *f, uint32_t i)
  * out of the frame at the apex) take no part in detecting flights either. */
 static bool usable(const gs_sample_full *s)
 {
-    return s && s->w >= USABLE_W_MIN && finite_r(s->x_px) && finite_r(s->y_px);
+    return s && s->w >= USABLE_W_MIN && gs_finite2_f(s->x_px, s->y_px);
 }
 
 static bool held(const gs_flight *f, uint32_t i) { return gs_ring_at(f->ring, ring_idx(f, i)) != NULL; }
@@ -334,9 +335,17 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->on_event = on_event;
     f->ctx = ctx;
     f->g_m_s2 = gs_core_config_g(cfg);
-    if (!span_cfg_us(cfg->min_flight_s, &f->min_flight_us) || !span_cfg_us(cfg->max_flight_s, &f->max_flight_us) ||
-        !span_cfg_us(cfg->max_gap_s, &f->max_gap_us) || !span_cfg_us(cfg->landing_latency_s, &f->landing_latency_us))
-        return GS_EINVAL;
+    /* the configured spans into f's four span fields, in turn */
+    static const uint8_t span_cfg[4] = {offsetof(gs_core_config, min_flight_s), offsetof(gs_core_config, max_flight_s),
+                                        offsetof(gs_core_config, max_gap_s), offsetof(gs_core_config, landing_latency_s)};
+    _Static_assert(offsetof(gs_flight, max_flight_us) == offsetof(gs_flight, min_flight_us) + 4 &&
+                   offsetof(gs_flight, max_gap_us) == offsetof(gs_flight, min_flight_us) + 8 &&
+                   offsetof(gs_flight, landing_latency_us) == offsetof(gs_flight, min_flight_us) + 12,
+                   "the span fields follow each other");
+    for (unsigned k = 0; k < 4; k++)
+        if (!span_cfg_us(*(const float *)(const void *)((const char *)cfg + span_cfg[k]),
+                         (int32_t *)(void *)((char *)f + offsetof(gs_flight, min_flight_us) + 4u * k)))
+            return GS_EINVAL;
     uint64_t head = gs_ring_head(ring);
     f->base = head > GS_FLIGHT_IDX_KEEP ? head - GS_FLIGHT_IDX_KEEP : 0u;
     f->next = idx_of(f, head);
@@ -1185,20 +1194,22 @@ static uint32_t contact_run(const gs_flight *f, const gs_fit_result *r, uint32_t
 /* The boundary time on one side (GS_T_NONE: unknown) from the flight's edge and the contact
  * samples past it (those end where contact was detected, alarm: further out the ground
  * phase is no longer a constant force); *outer = the outermost contact sample. */
-static int32_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool alarm,
-                            uint32_t edge, uint32_t other_edge, bool refine, gs_real pen,
-                            uint32_t *outer)
+static int32_t boundary_time(const gs_flight *f, const gs_close *c, int side, bool refine, uint32_t *outer)
 {
     const gs_fit_result *r = &c->r;
+    uint32_t edge = side < 0 ? f->fl_first : f->fl_last, other_edge = side < 0 ? f->fl_last : f->fl_first;
+    bool alarm = (side < 0 ? c->left_alarm : c->right_alarm) != GS_NO_IDX;
     uint32_t first = edge;  /* the first contact sample */
     *outer = edge;
     if (!refine) return GS_LT_NONE;
     uint32_t n = alarm ? contact_run(f, r, edge, side, c->head, outer, &first) : 0;
     /* two or more contact samples with a growing deviation: a constant-force model
      * past the boundary gives a sub-frame time; one: the midpoint is all we know */
-    if (n >= 2)
+    if (n >= 2) {
+        gs_real sig = fit_sigma(f, r);
         return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
-                               side, edge, *outer, pen, r);
+                               side, edge, *outer, DROP_PENALTY * sig * sig, r);
+    }
     if (n == 1) {
         int32_t t_first = lt_at(f, first), t_edge = lt_at(f, edge);  /* both held: L is */
         return t_edge + (t_first - t_edge) / 2;
@@ -1252,7 +1263,7 @@ static NOINLINE void restart_levels(gs_flight *f, uint32_t i)
 /* The close is over: the next flight may start right after this landing (land_idx: the
  * first sample after the flight, GS_NO_IDX unknown), its take-off side must see the
  * contact samples that follow it */
-static void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
+static NOINLINE void close_done(gs_flight *f, gs_close *c, uint32_t land_idx)
 {
     f->quiet_from = land_idx < c->newest ? land_idx : c->newest;  /* (GS_NO_IDX is above every index) */
     restart_levels(f, c->newest);  /* next seeds start after the landing */
@@ -1300,10 +1311,12 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
-        if (apex_us != GS_T_NONE && c0 != GS_T_NONE && c1 != GS_T_NONE) {
+        bool known = apex_us != GS_T_NONE && c0 != GS_T_NONE;
+        int64_t c0_from = known ? c0 - FEET_BEFORE_COM_US : 0;  /* the feet's events count from here */
+        if (known && c1 != GS_T_NONE) {
 
             /* (both within the local range: near the flight's held samples) */
-            int64_t F0_us = gs_feet_takeoff(&f->feet, c0 - FEET_BEFORE_COM_US, apex_us, &c->floor_off_px);
+            int64_t F0_us = gs_feet_takeoff(&f->feet, c0_from, apex_us, &c->floor_off_px);
             int64_t from = c1 - FEET_BEFORE_COM_US > apex_us ? c1 - FEET_BEFORE_COM_US : apex_us;
             int64_t F1_us = gs_feet_landing(&f->feet, from, c1 + FEET_AFTER_COM_US, &c->floor_on_px, &c->floor_before_px);
             c->F0_lus = F0_us != GS_T_NONE ? lt_of(f, F0_us) : GS_LT_NONE;
@@ -1317,7 +1330,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         /* feet in view that rest on the floor at the apex, or left it and did not come back
          * around the COM's landing, say the body was not in flight there (feet that never
          * rested, as in quick hops, say nothing: the COM times the flight) */
-        if (apex_us != GS_T_NONE && c0 != GS_T_NONE && gs_feet_seen_since(&f->feet, c0 - FEET_BEFORE_COM_US))
+        if (known && gs_feet_seen_since(&f->feet, c0_from))
             c->feet_contradict = gs_feet_resting_at(&f->feet, apex_us) ||
                               (F0 != GS_LT_NONE && F1 == GS_LT_NONE && gs_feet_airborne(&f->feet));
         /* a fall: the feet went well below the floor they left (a box): after a clean take-off
@@ -1336,11 +1349,9 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
     bool feet = GS_WITH_POSE && c->F0_lus != GS_LT_NONE && c->F1_lus != GS_LT_NONE;
     if (GS_WITH_POSE) c->feet = feet;
     bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
-    gs_real sig = fit_sigma(f, r);
-    gs_real pen = DROP_PENALTY * sig * sig;
     uint32_t lo, hi;  /* the outermost contact samples */
-    int32_t T0 = c->T0_lus = boundary_time(f, c, -1, c->left_alarm != GS_NO_IDX, L, R, refine, pen, &lo);
-    int32_t T1 = c->T1_lus = boundary_time(f, c, +1, c->right_alarm != GS_NO_IDX, R, L, refine, pen, &hi);
+    int32_t T0 = c->T0_lus = boundary_time(f, c, -1, refine, &lo);
+    int32_t T1 = c->T1_lus = boundary_time(f, c, +1, refine, &hi);
     DBG("close: L=%llu R=%llu lo=%llu hi=%llu T0=%lld T1=%lld a=%.1f\n",
         (unsigned long long)L, (unsigned long long)R, (unsigned long long)lo, (unsigned long long)hi,
         (long long)T0, (long long)T1, r->a_px_s2);
@@ -1422,6 +1433,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
+    uint32_t warn = 0;  /* j->warnings, set once */
 
     {
         gs_real g = f->g_m_s2;
@@ -1439,16 +1451,17 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         j->takeoff_velocity_m_s = g * rise_t;
         /* a rebound: the ground contact since the last landing, no stance between */
         j->contact_time_s = j->rsi = NAN;
-        if (f->last_land_us != GS_T_NONE && T0_us > f->last_land_us && T0_us - f->last_land_us <= CONTACT_MAX_US &&
+        /* 0 < T0 - last <= CONTACT_MAX_US unsigned: GS_T_NONE lies 2^62 us or more before any T0 */
+        if ((uint64_t)T0_us - (uint64_t)f->last_land_us - 1u < (uint64_t)CONTACT_MAX_US &&
             !(f->stand_last_us > f->last_land_us)) {
             j->contact_time_s = gs_time_span_s(T0_us, f->last_land_us);
             j->rsi = j->jump_height_m / j->contact_time_s;
         }
-        if (!IS_RIGID(f) && !feet) j->warnings |= GS_WARN_COM_TIMED;
+        if (!IS_RIGID(f) && !feet) warn |= GS_WARN_COM_TIMED;
         /* the stature only where the body stood at the flight's place (its feet on the same floor row) */
         if (feet && f->feet.epoch == f->stand_floor_epoch && finite_r(f->stand_floor_px) &&
             finite_r(c->floor_off_px) && GS_FABSR((gs_real)(c->floor_off_px - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
-            j->warnings |= GS_WARN_DEPTH_CHANGED;
+            warn |= GS_WARN_DEPTH_CHANGED;
             size = size_se = NAN;
             j->size_px = NAN;
         }
@@ -1467,7 +1480,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         f->last_land_us = F1 != GS_LT_NONE ? abs_of(f, F1) : T1_us;  /* (a fall's landing is the feet's, for the rebound's contact) */
         /* a body measured without a size: its flight is still a flight (its height unknown) */
         bool sizeless_ok = !IS_RIGID(f) && feet;
-        if (!finite_r(size) && sizeless_ok && !(j->warnings & GS_WARN_DEPTH_CHANGED)) j->warnings |= GS_WARN_NO_SIZE;
+        if (!finite_r(size) && sizeless_ok && !(warn & GS_WARN_DEPTH_CHANGED)) warn |= GS_WARN_NO_SIZE;
 
         if ((GS_WITH_POSE && c->fell) || (F1 != GS_LT_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
             j->reason = GS_REJ_FALL;
@@ -1491,14 +1504,15 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
         /* the same posture at both ends puts the COM at the same height (feet times only) */
         if (feet) {
             gs_real du = fit_u_at(&fr, T1_us) - fit_u_at(&fr, T0_us);
-            if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) j->warnings |= GS_WARN_COM_MISMATCH;
+            if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) warn |= GS_WARN_COM_MISMATCH;
         }
 
-        if (n_in < 2u * f->cfg->min_samples) j->warnings |= GS_WARN_FEW_SAMPLES;
-        if (n_out * 5u > n_in) j->warnings |= GS_WARN_OUTLIERS;
-        if (c->truncated) j->warnings |= GS_WARN_CLIPPED;
+        if (n_in < 2u * f->cfg->min_samples) warn |= GS_WARN_FEW_SAMPLES;
+        if (n_out * 5u > n_in) warn |= GS_WARN_OUTLIERS;
+        if (c->truncated) warn |= GS_WARN_CLIPPED;
         if (GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))  /* (NaN before an accepted flight) */
-            j->warnings |= GS_WARN_GRAVITY_TILT;
+            warn |= GS_WARN_GRAVITY_TILT;
+        j->warnings = warn;
     }
 
     if (j->accepted) {
@@ -1523,15 +1537,31 @@ done:
 
 static void seed_found(gs_flight *f, uint32_t newest);
 
+#if GS_CLOSE_LAG_FRAMES == 0
+/* Without a lag (the firmware) every close runs whole: its steps in order, no stage kept */
+static void close_run(gs_flight *f, gs_close *c, bool all)
+{
+    fit_memo memo = {0}, *m = &memo;
+    bool spent;  /* (every step runs: unused) */
+    (void)all;
+    gs_fit_result r;
+    if (c->stage == GS_CLOSE_REFIT) refit_range(f, m, f->fl_first, f->fl_last, &r);
+    uint8_t stage = close_start(f, c);
+    while (stage == GS_CLOSE_GROW) stage = grow_left_step(f, c, m, true, &spent);
+    if (stage == GS_CLOSE_GROWN) {
+        f->fl_first = c->clean;
+        if (refit_range(f, m, f->fl_first, f->fl_last, &r)) gs_fit_solve(&f->fit, &c->r);
+        stage = GS_CLOSE_BOUNDS;
+    }
+    if (stage == GS_CLOSE_BOUNDS) { close_bounds(f, c); close_final(f, c, m); }
+    c->stage = GS_CLOSE_NONE;
+}
+#else
 /* Take the close's steps: all of them (all), else until one has run a robust fit or the
  * boundary search. */
 static void close_run(gs_flight *f, gs_close *c, bool all)
 {
-#if GS_CLOSE_LAG_FRAMES > 0
     fit_memo *m = &c->memo;
-#else
-    fit_memo memo = {0}, *m = &memo;  /* (every step in this call) */
-#endif
     bool spent = false;
     uint8_t stage = c->stage;
     while (stage != GS_CLOSE_NONE && (all || !spent)) {
@@ -1571,6 +1601,8 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
     }
     c->stage = stage;
 }
+
+#endif
 
 /* Begin closing the open candidate. right_alarm: the sample at which contact was
  * detected after the flight (GS_NO_IDX when it ended otherwise); refit: rebuild the
@@ -1807,7 +1839,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     keep_size(f->stand_size, &f->stand_n, &f->stand_next, s->size_px);
     f->stand_last_us = s->t_us;
     /* body axis -> image up, until flights measure gravity directly */
-    if (!f->up_from_flight && finite_r(s->up_x) && finite_r(s->up_y)) {
+    if (!f->up_from_flight && gs_finite2_f(s->up_x, s->up_y)) {
         gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
         gs_real ux = (GS_R(1.0) - kw) * f->up_x + kw * (gs_real)s->up_x;
         gs_real uy = (GS_R(1.0) - kw) * f->up_y + kw * (gs_real)s->up_y;
@@ -1856,9 +1888,11 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 {
     /* history for the median of three and second differences */
     if (f->n_hist == 3) {
-        f->u_hist[0] = f->u_hist[1]; f->u_hist[1] = f->u_hist[2];
-        f->i_hist[0] = f->i_hist[1]; f->i_hist[1] = f->i_hist[2];
-        f->t_hist_us[0] = f->t_hist_us[1]; f->t_hist_us[1] = f->t_hist_us[2];
+        for (unsigned k = 0; k < 2; k++) {
+            f->u_hist[k] = f->u_hist[k + 1];
+            f->i_hist[k] = f->i_hist[k + 1];
+            f->t_hist_us[k] = f->t_hist_us[k + 1];
+        }
         f->n_hist = 2;
     }
     f->u_hist[f->n_hist] = u_of(f, s);
@@ -1962,46 +1996,40 @@ static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_ful
 
 static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
 {
+    uint32_t alarm = GS_NO_IDX;  /* the landing's contact alarm (one call of land below) */
     if (f->feet_wait_us != GS_T_NONE) {  /* the COM landed: waiting for the feet */
-        if (s->t_us >= f->feet_wait_us || !gs_feet_airborne(&f->feet)) land(f, idx, f->wait_alarm, s);
-        return;
+        if (s->t_us < f->feet_wait_us && gs_feet_airborne(&f->feet)) return;
+        alarm = f->wait_alarm;
+        goto landed;
     }
     gs_fit_result r;
     if (idx <= f->fl_last) return;  /* already in the seed's core */
     int32_t t = lt_of(f, s->t_us);
-    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(t, lt_at(f, f->seed_idx), f->max_flight_us)) {
-        land(f, idx, GS_NO_IDX, s);
-        return;
-    }
-    if (r.n >= 8 && !plausible_fall(f, &r, gate_size(f, idx))) {  /* a standing phase, not a flight */
-        land(f, idx, GS_NO_IDX, s);
-        return;
-    }
+    if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(t, lt_at(f, f->seed_idx), f->max_flight_us))
+        goto landed;
+    if (r.n >= 8 && !plausible_fall(f, &r, gate_size(f, idx)))  /* a standing phase, not a flight */
+        goto landed;
     uint32_t k = idx - f->fl_last - 1;  /* position among the pending samples */
-    if (k >= 32) { land(f, idx, GS_NO_IDX, s); return; }
+    if (k >= 32) goto landed;
     gs_real z;
     bool ok = test_sample(f, &r, s, &z);
     DBG("t=%lld ok=%d z=%.2f S=%.2f n=%u a=%.1f noise=%.3f rms=%.3f\n", (long long)s->t_us, ok, z, f->cusum, r.n, r.a_px_s2, f->noise_px, r.rms_px);
     if (!ok) {
-        if (++f->outliers_run >= 3) land(f, idx, GS_NO_IDX, s);
+        if (++f->outliers_run >= 3) goto landed;
         return;
     }
     f->outliers_run = 0;
     f->cusum = cusum_step(f->cusum, z);
+    alarm = idx;
     /* deviations that persist for the configured latency end the flight, alarm or not */
-    if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us)) {
-        land(f, idx, idx, s);
-        return;
-    }
+    if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us))
+        goto landed;
     if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
         fit_memo m = {0};
-        if (alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) {
-            f->fl_last = idx;   /* the refit took every sample through idx */
-            f->cusum = GS_R(0.0);
-            f->pend_ok = 0;
-            return;
-        }
-        land(f, idx, idx, s);
+        if (!alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) goto landed;
+        f->fl_last = idx;   /* the refit took every sample through idx */
+        f->cusum = GS_R(0.0);
+        f->pend_ok = 0;
         return;
     }
     f->pend_ok |= 1u << k;
@@ -2016,6 +2044,9 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
         f->fl_last = idx;
         f->pend_ok = 0;
     }
+    return;
+landed:
+    land(f, idx, alarm, s);
 }
 
 /* Keep the offsets small: once the ring's head is 2 x GS_FLIGHT_IDX_KEEP past the base,

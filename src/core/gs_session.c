@@ -111,6 +111,12 @@ void gs_session_jump(gs_session *s, const gs_ev_jump *j)
     tally(j->takeoff_velocity_m_s, &s->sum_v_m_s, &s->n_v, NULL);
 }
 
+/* a tally's mean, NaN without values */
+static NOINLINE gs_real mean_of(gs_real sum, uint32_t n)
+{
+    return n ? sum / (gs_real)n : (gs_real)NAN;
+}
+
 void gs_session_event(const gs_session *s, bool ended, const char *reason, const gs_ev_height *stature,
                       uint32_t track, gs_event *ev)
 {
@@ -136,9 +142,9 @@ void gs_session_event(const gs_session *s, bool ended, const char *reason, const
     }
     e->best_jump_m = s->best_jump_m;
     e->best_flight_s = s->best_flight_s;
-    if (s->n_jump_h) e->mean_jump_m = s->sum_jump_m / (gs_real)s->n_jump_h;
-    if (s->n_flight_t) e->mean_flight_s = s->sum_flight_s / (gs_real)s->n_flight_t;
-    if (s->n_v) e->mean_takeoff_velocity_m_s = s->sum_v_m_s / (gs_real)s->n_v;
+    e->mean_jump_m = mean_of(s->sum_jump_m, s->n_jump_h);
+    e->mean_flight_s = mean_of(s->sum_flight_s, s->n_flight_t);
+    e->mean_takeoff_velocity_m_s = mean_of(s->sum_v_m_s, s->n_v);
 }
 
 void gs_session_close(gs_session *s)
