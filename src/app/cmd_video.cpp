@@ -68,7 +68,7 @@ const char kHelp[] =
     "  --threads N          threads of the pose networks and of OpenCV (default: half\n"
     "                       the CPUs allowed with --prefetch, else all of them)\n"
     "  --prefetch N         pose: decode and run the networks up to N frames ahead\n"
-    "                       of the rest, in two more threads (default 4; 0: all in\n"
+    "                       of the rest, in two more threads (default 8; 0: all in\n"
     "                       one thread); the output is the same\n"
     "  --stabilize on|off   pose: map keypoints into the first frame's view using the\n"
     "                       background's motion (default on; flights still carry\n"
@@ -99,7 +99,7 @@ struct Options {
     std::string input, config, trace, overlay, plot, detector = "ball";
     std::string model, models, engine;
     int threads = -1;              // -1: from the config
-    int prefetch = 4;              // pose: frames decoded and posed ahead (0: one thread); 4 absorbs a census frame
+    int prefetch = 8;              // pose: frames decoded and posed ahead (0: one thread); 8 keeps both CPUs busy through census frames
     bool stabilize = true;
     double fps = 0.0;
     bool out_format_set = false;
