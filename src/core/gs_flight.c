@@ -1537,31 +1537,15 @@ done:
 
 static void seed_found(gs_flight *f, uint32_t newest);
 
-#if GS_CLOSE_LAG_FRAMES == 0
-/* Without a lag (the firmware) every close runs whole: its steps in order, no stage kept */
-static void close_run(gs_flight *f, gs_close *c, bool all)
-{
-    fit_memo memo = {0}, *m = &memo;
-    bool spent;  /* (every step runs: unused) */
-    (void)all;
-    gs_fit_result r;
-    if (c->stage == GS_CLOSE_REFIT) refit_range(f, m, f->fl_first, f->fl_last, &r);
-    uint8_t stage = close_start(f, c);
-    while (stage == GS_CLOSE_GROW) stage = grow_left_step(f, c, m, true, &spent);
-    if (stage == GS_CLOSE_GROWN) {
-        f->fl_first = c->clean;
-        if (refit_range(f, m, f->fl_first, f->fl_last, &r)) gs_fit_solve(&f->fit, &c->r);
-        stage = GS_CLOSE_BOUNDS;
-    }
-    if (stage == GS_CLOSE_BOUNDS) { close_bounds(f, c); close_final(f, c, m); }
-    c->stage = GS_CLOSE_NONE;
-}
-#else
 /* Take the close's steps: all of them (all), else until one has run a robust fit or the
  * boundary search. */
 static void close_run(gs_flight *f, gs_close *c, bool all)
 {
+#if GS_CLOSE_LAG_FRAMES > 0
     fit_memo *m = &c->memo;
+#else
+    fit_memo memo = {0}, *m = &memo;  /* without a lag every close runs whole in one call */
+#endif
     bool spent = false;
     uint8_t stage = c->stage;
     while (stage != GS_CLOSE_NONE && (all || !spent)) {
@@ -1601,8 +1585,6 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
     }
     c->stage = stage;
 }
-
-#endif
 
 /* Begin closing the open candidate. right_alarm: the sample at which contact was
  * detected after the flight (GS_NO_IDX when it ended otherwise); refit: rebuild the
