@@ -610,6 +610,137 @@ void good_features(const cv::Mat &img, std::vector<cv::Point2f> &corners, int ma
     for (const cv::Point2f &p : corners) grid[static_cast<size_t>(static_cast<int>(p.y) / cell) * gw + static_cast<int>(p.x) / cell].clear();
 }
 
+namespace {
+
+constexpr int kDerivSpan = 8;  // columns of a row whose derivatives are computed, and remembered, together
+
+// the row or column Scharr takes beyond an image's edge (lkpyramid.cpp: reflect-101, 0 for one pixel)
+inline int scharr_neighbour(int i, int n)
+{
+    if (i < 0) return n > 1 ? 1 : 0;
+    if (i >= n) return n > 1 ? n - 2 : 0;
+    return i;
+}
+
+}  // namespace
+
+void LkDerivatives::reset(const std::vector<cv::Mat> &levels, cv::Size win)
+{
+    win_ = win;
+    const size_t n = levels.size();
+    bordered_.resize(n);
+    done_.resize(n);
+    whole_.assign(n, 0);
+    pyr_.resize(2 * n);
+    for (size_t l = 0; l < n; l++) {
+        const cv::Mat &img = levels[l];
+        cv::Mat &d = bordered_[l];
+        const cv::Size whole(img.cols + 2 * win.width, img.rows + 2 * win.height);
+        if (d.size() != whole || d.type() != CV_16SC2) {
+            d.create(whole, CV_16SC2);
+            d.setTo(cv::Scalar::all(0));  // the border stays zero (buildOpticalFlowPyramid's BORDER_CONSTANT)
+        }
+        pyr_[2 * l] = img;
+        pyr_[2 * l + 1] = d(cv::Rect(win.width, win.height, img.cols, img.rows));
+        const int spans = (img.cols + kDerivSpan - 1) / kDerivSpan;
+        done_[l].assign(static_cast<size_t>(spans) * img.rows, 0);
+    }
+}
+
+void LkDerivatives::cover(const std::vector<cv::Point2f> &pts)
+{
+    for (int l = 0; l < static_cast<int>(done_.size()); l++) cover_level(l, pts);
+}
+
+void LkDerivatives::cover_level(int level, const std::vector<cv::Point2f> &pts)
+{
+    if (whole_[level]) return;
+    const int w = pyr_[2 * level].cols, h = pyr_[2 * level].rows;
+    const int spans = (w + kDerivSpan - 1) / kDerivSpan;
+    std::vector<uchar> &done = done_[level];
+    // windows that would cover 30 % of a level or more (the coarse ones): all of it in one
+    // pass, row after row, costs less than the windows' rows one by one
+    const double windows = static_cast<double>(pts.size()) * (win_.width + 3) * (win_.height + 3);
+    if (windows >= 0.3 * w * h) {
+        fill(level, 0, w, 0, h);
+        whole_[level] = 1;
+        return;
+    }
+    // LKTrackerInvoker's window at this level: the point scaled, less half the window, floored;
+    // it reads the window and one column to the right and one row below (the bilinear taps)
+    const float to_level = static_cast<float>(1. / (1 << level));
+    const cv::Point2f half_win((win_.width - 1) * 0.5f, (win_.height - 1) * 0.5f);
+    for (const cv::Point2f &p : pts) {
+        const cv::Point2f q = p * to_level - half_win;
+        if (!(std::fabs(q.x) < 1e6f && std::fabs(q.y) < 1e6f)) continue;  // far outside (or NaN): never read
+        const int ix = cvFloor(q.x), iy = cvFloor(q.y);
+        // a pixel more than read on each side, so that no rounding can leave one out
+        const int x0 = std::max(ix - 1, 0), x1 = std::min(ix + win_.width + 1, w - 1);
+        const int y0 = std::max(iy - 1, 0), y1 = std::min(iy + win_.height + 1, h - 1);
+        if (x0 > x1 || y0 > y1) continue;
+        const int s_first = x0 / kDerivSpan, s_last = x1 / kDerivSpan;
+        for (int y = y0; y <= y1; y++) {
+            uchar *row = &done[static_cast<size_t>(y) * spans];
+            for (int s = s_first; s <= s_last;) {
+                if (row[s]) {
+                    s++;
+                    continue;
+                }
+                int end = s;  // the run of spans not yet computed, computed at once
+                while (end <= s_last && !row[end]) row[end++] = 1;
+                fill(level, s * kDerivSpan, std::min(end * kDerivSpan, w), y, y + 1);
+                s = end;
+            }
+        }
+    }
+}
+
+// OpenCV's Scharr derivatives (lkpyramid.cpp, ScharrDerivInvoker) of columns
+// [x0, x1) and rows [y0, y1) of one level: per column 3a + 10b + 3c and c - a
+// down the rows above, at and below, then across the same for the columns left
+// and right, in 16-bit integers, stored as (dx, dy) pairs
+void LkDerivatives::fill(int level, int x0, int x1, int y0, int y1)
+{
+    const cv::Mat &img = pyr_[2 * level];
+    cv::Mat &deriv = pyr_[2 * level + 1];
+    const int w = img.cols, h = img.rows;
+    for (int y = y0; y < y1; y++) {
+        const uchar *a = img.ptr<uchar>(scharr_neighbour(y - 1, h)), *b = img.ptr<uchar>(y);
+        const uchar *c = img.ptr<uchar>(scharr_neighbour(y + 1, h));
+        short *d = deriv.ptr<short>(y);
+        auto smooth = [&](int x) { return (a[x] + c[x]) * 3 + b[x] * 10; };
+        auto diff = [&](int x) { return c[x] - a[x]; };
+        auto one = [&](int x) {  // one column (the edges' and those the 8-column steps leave)
+            const int l = scharr_neighbour(x - 1, w), r = scharr_neighbour(x + 1, w);
+            d[2 * x] = static_cast<short>(smooth(r) - smooth(l));
+            d[2 * x + 1] = static_cast<short>((diff(r) + diff(l)) * 3 + diff(x) * 10);
+        };
+        int x = x0;
+        for (; x < std::min(x1, 1); x++) one(x);
+#ifdef __SSE2__
+        // 8 columns at a time, their neighbours' sums from loads one column to each side
+        // (in registers: a row of sums stored and read back unaligned stalls on the store)
+        const __m128i z = _mm_setzero_si128(), c3 = _mm_set1_epi16(3), c10 = _mm_set1_epi16(10);
+        auto load8 = [z](const uchar *p) {
+            return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i *>(p)), z);
+        };
+        for (; x + 8 <= std::min(x1, w - 1); x += 8) {
+            const __m128i al = load8(a + x - 1), am = load8(a + x), ar = load8(a + x + 1);
+            const __m128i bl = load8(b + x - 1), br = load8(b + x + 1);
+            const __m128i cl = load8(c + x - 1), cm = load8(c + x), cr = load8(c + x + 1);
+            const __m128i sl = _mm_add_epi16(_mm_mullo_epi16(_mm_add_epi16(al, cl), c3), _mm_mullo_epi16(bl, c10));
+            const __m128i sr = _mm_add_epi16(_mm_mullo_epi16(_mm_add_epi16(ar, cr), c3), _mm_mullo_epi16(br, c10));
+            const __m128i side = _mm_add_epi16(_mm_sub_epi16(cl, al), _mm_sub_epi16(cr, ar));
+            const __m128i dx = _mm_sub_epi16(sr, sl);
+            const __m128i dy = _mm_add_epi16(_mm_mullo_epi16(side, c3), _mm_mullo_epi16(_mm_sub_epi16(cm, am), c10));
+            _mm_storeu_si128(reinterpret_cast<__m128i *>(d + 2 * x), _mm_unpacklo_epi16(dx, dy));
+            _mm_storeu_si128(reinterpret_cast<__m128i *>(d + 2 * x + 8), _mm_unpackhi_epi16(dx, dy));
+        }
+#endif
+        for (; x < x1; x++) one(x);
+    }
+}
+
 CameraMotion::CameraMotion(const CameraMotionConfig &cfg) : cfg_(cfg), cur_from_ref_(1, 0, 0, 0, 1, 0) {}
 
 void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &exclude, CameraMotionFrame *out)
@@ -646,11 +777,11 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
 
     // the pyramid of this frame, built once: it is the next frame's previous one
     // (calcOpticalFlowPyrLK given the images builds the same pyramids, both each time);
-    // with its gradients, which both Lucas-Kanade passes would otherwise compute again
+    // its derivatives only where the next frame's Lucas-Kanade passes read them (prev_deriv_)
     const cv::Size win(21, 21);
     const int levels = 3;
     std::vector<cv::Mat> &pyr = spare_pyr_;
-    cv::buildOpticalFlowPyramid(cur, pyr, win, levels, true);
+    cv::buildOpticalFlowPyramid(cur, pyr, win, levels, false);
 
     bool matched = false;
     if (have_ && !pts_.empty()) {
@@ -661,7 +792,10 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
             if (!inside_any(ex, p)) from.push_back(p);
         std::vector<uchar> st;
         // no error output: OpenCV would sample every window once more for it
-        if (!from.empty()) cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, from, next, st, cv::noArray(), win, levels);
+        if (!from.empty()) {
+            prev_deriv_.cover(from);
+            cv::calcOpticalFlowPyrLK(prev_deriv_.pyramid(), pyr, from, next, st, cv::noArray(), win, levels);
+        }
         std::vector<cv::Point2f> a, b;
         for (size_t i = 0; i < from.size(); i++)
             if (st[i] && !inside_any(ex, next[i])) {
@@ -728,6 +862,7 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
             }
     }
     prev_pyr_.swap(pyr);
+    prev_deriv_.reset(prev_pyr_, win);
     have_ = true;
 }
 
@@ -764,7 +899,8 @@ int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vecto
     if (p0.empty()) return 0;
     for (cv::Point2f &p : p0) p = cv::Point2f(2.0f * p.x + 0.5f + (float)box.x, 2.0f * p.y + 0.5f + (float)box.y);
     std::vector<uchar> st;
-    cv::calcOpticalFlowPyrLK(prev_pyr_, pyr, p0, p1, st, cv::noArray(), cv::Size(21, 21), 3);  // both pyramids built once
+    prev_deriv_.cover(p0);  // both pyramids built once, the derivatives where this pass reads them
+    cv::calcOpticalFlowPyrLK(prev_deriv_.pyramid(), pyr, p0, p1, st, cv::noArray(), cv::Size(21, 21), 3);
     const double thr = cfg_.other_px * scale_;
     int n = 0;
     for (size_t i = 0; i < p0.size(); i++) {

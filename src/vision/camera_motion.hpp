@@ -62,6 +62,33 @@ struct CornerWork {
 void good_features(const cv::Mat &img, std::vector<cv::Point2f> &corners, int max_corners, double quality,
                    double min_distance, const cv::Mat &mask, int block, CornerWork &work);
 
+// The Scharr derivative levels of a Lucas-Kanade pyramid, laid out as
+// cv::buildOpticalFlowPyramid lays them out (CV_16SC2, the level's size plus a
+// window-sized zero border on each side) and with the same values, computed
+// only where cv::calcOpticalFlowPyrLK reads them: the windows around the points
+// it is given, at every level. Tracking 150 corners on a 640 px wide frame
+// reads about an eighth of the finest level, the largest and costliest.
+class LkDerivatives {
+public:
+    // levels: the image levels (cv::buildOpticalFlowPyramid without derivatives),
+    // whose derivatives start out not computed
+    void reset(const std::vector<cv::Mat> &levels, cv::Size win);
+    // computes the derivatives calcOpticalFlowPyrLK(pyramid(), ..., pts, ..., win)
+    // reads at every level (those not computed yet)
+    void cover(const std::vector<cv::Point2f> &pts);
+    // [image 0, derivatives 0, image 1, derivatives 1, ...] for calcOpticalFlowPyrLK's previous pyramid
+    const std::vector<cv::Mat> &pyramid() const { return pyr_; }
+
+private:
+    void cover_level(int level, const std::vector<cv::Point2f> &pts);
+    void fill(int level, int x0, int x1, int y0, int y1);
+    cv::Size win_;
+    std::vector<cv::Mat> pyr_;          // images and derivative regions, interleaved
+    std::vector<cv::Mat> bordered_;     // each level's derivatives with their zero border
+    std::vector<std::vector<uchar>> done_;  // per level, per row, per span of 8 columns: computed
+    std::vector<uchar> whole_;          // per level: all of it computed
+};
+
 class CameraMotion {
 public:
     explicit CameraMotion(const CameraMotionConfig &cfg = CameraMotionConfig());
@@ -76,6 +103,7 @@ private:
     double scale_ = 1.0;           // working / full
     std::vector<cv::Mat> prev_pyr_; // previous working grey frame's Lucas-Kanade pyramid
     std::vector<cv::Mat> spare_pyr_; // the one before, whose memory the next pyramid takes
+    mutable LkDerivatives prev_deriv_; // prev_pyr_'s derivatives, where Lucas-Kanade reads them
     cv::Mat grey_, cur_, mask_;     // this frame's grey, working image and corner mask
     mutable cv::Mat ring_mask_;     // other_motion's ring
     mutable CornerWork corner_work_;
