@@ -1,9 +1,12 @@
 // test_camera_motion.cpp - the camera-motion tracker against truth: a textured
 // scene moved by known sub-pixel similarity transforms, a moving subject that
 // must not count as camera motion, and two real clips (a static campus camera;
-// a handheld phone in a gym whose view drifts ~45 px during the jump).
+// a handheld phone in a gym whose view drifts ~45 px during the jump); and
+// the parts that reproduce OpenCV's (area reduction, corners, Lucas-Kanade's
+// derivatives where it reads them) against OpenCV itself.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <sys/stat.h>
 #include <vector>
@@ -11,6 +14,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/video/tracking.hpp>
 
 extern "C" {
 #include "unity.h"
@@ -361,6 +365,55 @@ static void test_corners_are_opencvs(void)
     TEST_ASSERT_EQUAL_INT(cases, same);
 }
 
+// Lucas-Kanade on a pyramid whose derivatives are computed only where it reads
+// them gives OpenCV's points and status bit for bit (the full pyramid built by
+// cv::buildOpticalFlowPyramid): corners, random points, points at and beyond the
+// edges, a second call with other points on the same pyramid, small frames whose
+// coarse levels are a few pixels wide
+static void test_lk_derivatives_are_opencvs(void)
+{
+    const cv::Size win(21, 21);
+    const int levels = 3;
+    cv::RNG rng(21);
+    int calls = 0, same = 0, points = 0, tracked = 0;
+    for (cv::Size sz : {cv::Size(640, 1138), cv::Size(320, 200), cv::Size(97, 61), cv::Size(40, 30)}) {
+        cv::Mat big = scene(sz.width + 80, sz.height + 80), a, b;
+        cv::cvtColor(view(big, 0, 0, 0, 1, sz), a, cv::COLOR_BGR2GRAY);
+        cv::cvtColor(view(big, 2.3, -1.6, 0.4, 1.003, sz), b, cv::COLOR_BGR2GRAY);
+        std::vector<cv::Mat> full_a, full_b, img_a, img_b;
+        cv::buildOpticalFlowPyramid(a, full_a, win, levels, true);
+        cv::buildOpticalFlowPyramid(b, full_b, win, levels, true);
+        cv::buildOpticalFlowPyramid(a, img_a, win, levels, false);
+        cv::buildOpticalFlowPyramid(b, img_b, win, levels, false);
+        gs::LkDerivatives lazy;
+        lazy.reset(img_a, win);
+        for (int call = 0; call < 3; call++) {
+            std::vector<cv::Point2f> pts;
+            if (call == 0) cv::goodFeaturesToTrack(a, pts, 80, 0.01, 8);
+            for (int i = 0; i < (call == 2 ? 3 : 60); i++)  // inside, at the edges and beyond them
+                pts.push_back(cv::Point2f(rng.uniform(-30.f, sz.width + 30.f), rng.uniform(-30.f, sz.height + 30.f)));
+            for (float e : {0.f, 0.5f, 1.f})
+                pts.push_back(cv::Point2f(e * (sz.width - 1), (1 - e) * (sz.height - 1)));
+            std::vector<cv::Point2f> want, got;
+            std::vector<uchar> st_want, st_got;
+            cv::calcOpticalFlowPyrLK(full_a, full_b, pts, want, st_want, cv::noArray(), win, levels);
+            lazy.cover(pts);
+            cv::calcOpticalFlowPyrLK(lazy.pyramid(), img_b, pts, got, st_got, cv::noArray(), win, levels);
+            bool eq = st_want == st_got && want.size() == got.size();
+            for (size_t i = 0; eq && i < want.size(); i++)
+                eq = std::memcmp(&want[i], &got[i], sizeof(cv::Point2f)) == 0;
+            calls++;
+            same += eq;
+            points += (int)pts.size();
+            for (uchar v : st_want) tracked += v;
+        }
+    }
+    std::printf("lucas-kanade: %d of %d calls as on OpenCV's full pyramid (%d points, %d tracked)\n", same, calls,
+                points, tracked);
+    TEST_ASSERT_TRUE(tracked > points / 2);
+    TEST_ASSERT_EQUAL_INT(calls, same);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -372,5 +425,6 @@ int main(void)
     RUN_TEST(test_area_reduction_is_opencvs);
     RUN_TEST(test_area_reduction_to_a_size_is_opencvs);
     RUN_TEST(test_corners_are_opencvs);
+    RUN_TEST(test_lk_derivatives_are_opencvs);
     return UNITY_END();
 }
