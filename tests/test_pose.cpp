@@ -19,6 +19,7 @@
 #include <unistd.h>  // rmdir
 
 #include <opencv2/core.hpp>
+#include <opencv2/dnn.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -247,6 +248,50 @@ void test_roi_crop_is_opencvs(void)
     }
     std::printf("roi crop: %d of %d crops as cv::warpAffine (%d frames of the gym clip)\n", same, cases,
                 static_cast<int>(imgs.size()) - 6);
+    TEST_ASSERT_EQUAL_INT(cases, same);
+}
+
+// the landmark network's blob is cv::dnn::blobFromImage's, float for float: every
+// byte value, the crops of real frames, random images of odd widths and views
+void test_roi_blob_is_opencvs(void)
+{
+    std::vector<cv::Mat> imgs;
+    cv::Mat bytes(1, 256, CV_8UC3);
+    for (int i = 0; i < 256; i++) bytes.at<cv::Vec3b>(0, i) = cv::Vec3b(i, 255 - i, (i * 7) & 255);
+    imgs.push_back(bytes);
+    char p_buf[512];
+    std::snprintf(p_buf, sizeof p_buf, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    cv::VideoCapture cap(p_buf);
+    cv::Mat f;
+    cv::RNG rng(12);
+    for (int i = 0; i < 4 && cap.read(f); i++) {
+        gs::PoseRoi r;
+        r.cx_px = 0.5 * f.cols;
+        r.cy_px = 0.5 * f.rows;
+        r.size_px = 1.2 * f.cols;
+        r.rotation_rad = rng.uniform(-0.5, 0.5);
+        cv::Mat crop;
+        gs::warp_crop_bgr(f, gs::pose_roi_crop_to_image(r, 256), 256, crop);
+        imgs.push_back(crop);
+    }
+    for (int i = 0; i < 20; i++) {
+        cv::Mat g(rng.uniform(1, 300), rng.uniform(1, 300), CV_8UC3);
+        rng.fill(g, cv::RNG::UNIFORM, 0, 256);
+        imgs.push_back(g);
+        if (g.cols > 2 && g.rows > 2) imgs.push_back(g(cv::Rect(1, 1, g.cols - 2, g.rows - 2)));
+    }
+    int cases = 0, same = 0;
+    for (const cv::Mat &img : imgs) {
+        for (double scale : {1.0 / 255.0, 1.0 / 127.5, 1.0, 0.3}) {
+            cv::Mat a, b;
+            cv::dnn::blobFromImage(img, a, scale, cv::Size(), cv::Scalar(), true, false, CV_32F);
+            gs::bgr_to_rgb_blob(img, scale, b);
+            cases++;
+            same += a.dims == 4 && b.dims == 4 && a.size == b.size && a.type() == b.type() &&
+                    std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+        }
+    }
+    std::printf("roi blob: %d of %d blobs as cv::dnn::blobFromImage\n", same, cases);
     TEST_ASSERT_EQUAL_INT(cases, same);
 }
 
@@ -704,6 +749,7 @@ int main(void)
     RUN_TEST(test_roi_maps_scale_point_to_crop_top);
     RUN_TEST(test_roi_crop_warp_finds_marker);
     RUN_TEST(test_roi_crop_is_opencvs);
+    RUN_TEST(test_roi_blob_is_opencvs);
     RUN_TEST(test_letterbox);
     RUN_TEST(test_decode_and_weighted_nms);
     RUN_TEST(test_config_keys);

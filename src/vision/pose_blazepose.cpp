@@ -689,7 +689,7 @@ struct PoseTracker::Impl {
     void landmarks(const cv::Mat &bgr, const PoseRoi &r, PoseOutput *out, PoseRoi *next)
     {
         crop_roi(bgr, r);
-        cv::dnn::blobFromImage(crop, blob, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F);
+        bgr_to_rgb_blob(crop, 1.0 / 255.0, blob);
         std::vector<cv::Mat> outs;
         lm->run(blob, lm_out, outs);
         const float *raw = outs[0].ptr<float>();
