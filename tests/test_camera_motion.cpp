@@ -3,7 +3,7 @@
 // must not count as camera motion, and two real clips (a static campus camera;
 // a handheld phone in a gym whose view drifts ~45 px during the jump); and
 // the parts that reproduce OpenCV's (area reduction, corners, Lucas-Kanade's
-// derivatives where it reads them) against OpenCV itself.
+// derivatives where it reads them, its tracking loop) against OpenCV itself.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -21,6 +21,7 @@ extern "C" {
 }
 
 #include "camera_motion.hpp"
+#include "lk_track.hpp"
 
 #ifndef GS_SHARED_DIR
 #error "GS_SHARED_DIR must be defined"
@@ -414,6 +415,83 @@ static void test_lk_derivatives_are_opencvs(void)
     TEST_ASSERT_EQUAL_INT(calls, same);
 }
 
+// gs::lk_track against cv::calcOpticalFlowPyrLK on the same pyramids, bit for bit:
+// real frame pairs (one and three frames apart) and synthetic views of several
+// sizes (the small ones with fewer levels), moved a little and too far to follow,
+// with a flat patch whose windows fail the eigenvalue test, and points inside, on
+// the edges and beyond them
+static void check_lk_track(const cv::Mat &a, const cv::Mat &b, const std::vector<cv::Point2f> &extra, cv::RNG &rng,
+                           int *calls, int *same, int *points, int *tracked)
+{
+    const cv::Size win(21, 21);
+    const int levels = 3;
+    std::vector<cv::Mat> img_a, img_b;
+    cv::buildOpticalFlowPyramid(a, img_a, win, levels, false);
+    cv::buildOpticalFlowPyramid(b, img_b, win, levels, false);
+    std::vector<cv::Point2f> pts;
+    if (a.cols >= 8 && a.rows >= 8) cv::goodFeaturesToTrack(a, pts, 150, 0.01, 8);
+    pts.insert(pts.end(), extra.begin(), extra.end());
+    for (int i = 0; i < 40; i++)
+        pts.push_back(cv::Point2f(rng.uniform(-30.f, a.cols + 30.f), rng.uniform(-30.f, a.rows + 30.f)));
+    for (float e : {0.f, 0.5f, 1.f}) {
+        pts.push_back(cv::Point2f(e * (a.cols - 1), (1 - e) * (a.rows - 1)));
+        pts.push_back(cv::Point2f(rng.uniform(-1.f, 1.f) + e * a.cols, rng.uniform(-1.f, 1.f)));
+    }
+    gs::LkDerivatives deriv;
+    deriv.reset(img_a, win);
+    deriv.cover(pts);
+    std::vector<cv::Point2f> want, got;
+    std::vector<uchar> st_want, st_got;
+    cv::calcOpticalFlowPyrLK(deriv.pyramid(), img_b, pts, want, st_want, cv::noArray(), win, levels);
+    gs::lk_track(deriv.pyramid(), img_b, pts, got, st_got, win, levels);
+    bool eq = st_want == st_got && want.size() == got.size();
+    for (size_t i = 0; eq && i < want.size(); i++) eq = std::memcmp(&want[i], &got[i], sizeof(cv::Point2f)) == 0;
+    (*calls)++;
+    *same += eq;
+    *points += (int)pts.size();
+    for (uchar v : st_want) *tracked += v;
+}
+
+static void test_lk_track_is_opencvs(void)
+{
+    cv::RNG rng(33);
+    int calls = 0, same = 0, points = 0, tracked = 0;
+    char p_buf[512];
+    std::snprintf(p_buf, sizeof p_buf, "%s/data/real/jumpvision_jumps/cmj_gym_handheld_30fps.mp4", GS_SHARED_DIR);
+    if (exists(p_buf)) {
+        cv::VideoCapture cap(p_buf);
+        std::vector<cv::Mat> greys;
+        cv::Mat f, g, w;
+        for (int i = 0; i < 12 && cap.read(f); i++) {
+            cv::cvtColor(f, g, cv::COLOR_BGR2GRAY);
+            gs::resize_area_grey(g, w, 640.0 / g.cols);
+            greys.push_back(w.clone());
+        }
+        for (size_t i = 0; i + 3 < greys.size(); i += 2) {
+            check_lk_track(greys[i], greys[i + 1], {}, rng, &calls, &same, &points, &tracked);
+            check_lk_track(greys[i], greys[i + 3], {}, rng, &calls, &same, &points, &tracked);
+        }
+    }
+    for (cv::Size sz : {cv::Size(640, 1138), cv::Size(640, 360), cv::Size(320, 200), cv::Size(97, 61), cv::Size(40, 30),
+                        cv::Size(23, 17)}) {
+        cv::Mat big = scene(sz.width + 200, sz.height + 200), a, b;
+        // a flat patch in both views: windows inside it have no gradient
+        const cv::Rect flat(sz.width / 4 + 100, sz.height / 4 + 100, sz.width / 4 + 30, sz.height / 4 + 30);
+        big(flat).setTo(cv::Scalar(120, 120, 120));
+        const std::vector<cv::Point2f> in_flat = {cv::Point2f(sz.width * 0.375f, sz.height * 0.375f)};
+        cv::cvtColor(view(big, 0, 0, 0, 1, sz), a, cv::COLOR_BGR2GRAY);
+        const double moves[][4] = {{2.3, -1.6, 0.4, 1.003}, {-0.4, 0.7, 0, 1}, {45, -38, 3, 1.05}, {90, 70, 0, 1}};
+        for (const double *m : moves) {
+            cv::cvtColor(view(big, m[0], m[1], m[2], m[3], sz), b, cv::COLOR_BGR2GRAY);
+            check_lk_track(a, b, in_flat, rng, &calls, &same, &points, &tracked);
+        }
+    }
+    std::printf("lucas-kanade loop: %d of %d calls as cv::calcOpticalFlowPyrLK (%d points, %d tracked)\n", same, calls,
+                points, tracked);
+    TEST_ASSERT_TRUE(tracked > points / 2 && tracked < points);
+    TEST_ASSERT_EQUAL_INT(calls, same);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -426,5 +504,6 @@ int main(void)
     RUN_TEST(test_area_reduction_to_a_size_is_opencvs);
     RUN_TEST(test_corners_are_opencvs);
     RUN_TEST(test_lk_derivatives_are_opencvs);
+    RUN_TEST(test_lk_track_is_opencvs);
     return UNITY_END();
 }

@@ -1,6 +1,7 @@
 // camera_motion.cpp - background corners tracked by pyramidal Lucas-Kanade,
 // a RANSAC similarity per frame pair, chained to the first frame.
 #include "camera_motion.hpp"
+#include "lk_track.hpp"
 
 #include <algorithm>
 #include <cfloat>
@@ -791,10 +792,11 @@ void CameraMotion::process(const cv::Mat &bgr, const std::vector<cv::Rect> &excl
         for (const cv::Point2f &p : pts_)
             if (!inside_any(ex, p)) from.push_back(p);
         std::vector<uchar> st;
-        // no error output: OpenCV would sample every window once more for it
+        // Lucas-Kanade as cv::calcOpticalFlowPyrLK without its error output (which would
+        // sample every window once more), points and status bit for bit (lk_track.hpp)
         if (!from.empty()) {
             prev_deriv_.cover(from);
-            cv::calcOpticalFlowPyrLK(prev_deriv_.pyramid(), pyr, from, next, st, cv::noArray(), win, levels);
+            lk_track(prev_deriv_.pyramid(), pyr, from, next, st, win, levels);
         }
         std::vector<cv::Point2f> a, b;
         for (size_t i = 0; i < from.size(); i++)
@@ -900,7 +902,7 @@ int CameraMotion::other_motion(const std::vector<cv::Mat> &pyr, const std::vecto
     for (cv::Point2f &p : p0) p = cv::Point2f(2.0f * p.x + 0.5f + (float)box.x, 2.0f * p.y + 0.5f + (float)box.y);
     std::vector<uchar> st;
     prev_deriv_.cover(p0);  // both pyramids built once, the derivatives where this pass reads them
-    cv::calcOpticalFlowPyrLK(prev_deriv_.pyramid(), pyr, p0, p1, st, cv::noArray(), cv::Size(21, 21), 3);
+    lk_track(prev_deriv_.pyramid(), pyr, p0, p1, st, cv::Size(21, 21), 3);
     const double thr = cfg_.other_px * scale_;
     int n = 0;
     for (size_t i = 0; i < p0.size(); i++) {
