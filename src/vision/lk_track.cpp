@@ -251,40 +251,51 @@ __attribute__((target("avx2"))) void sample_prev(const cv::Mat &img, const cv::M
 }
 
 // OpenCV's mismatch sums b1, b2 of the next image's window at (x, y) (weights w)
+// One window row's terms of the b sums against the next image at (x, y + r):
+// p0, p1 the first sixteen columns' products paired as OpenCV pairs them
+// (k, k + 4, k, k + 4, k + 1, k + 5, ...), dx and dy the last columns' products
+// (madd's: the derivatives' upper halves are zero); all exact integers
+struct RowTerms {
+    __m256i p0, p1, dx, dy;
+};
+
+__attribute__((target("avx2"))) inline RowTerms row_terms(const uchar *src, size_t step, const PairWeights &pwt,
+                                                          const PrevWindow &pw, int r)
+{
+    const __m256i pair0 = _mm256_setr_epi8(0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11,  //
+                                           0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11);
+    const __m256i pair1 = _mm256_setr_epi8(4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15,  //
+                                           4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15);
+    const __m256i diff = _mm256_subs_epi16(image16(src, step, pwt),
+                                           _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.img[r])));
+    const __m256i td = _mm256_sub_epi32(image_tail(src, step, pwt),
+                                        _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_img[r])));
+    RowTerms t;
+    t.p0 = _mm256_madd_epi16(_mm256_shuffle_epi8(diff, pair0), _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.d10[r])));
+    t.p1 = _mm256_madd_epi16(_mm256_shuffle_epi8(diff, pair1), _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.d11[r])));
+    t.dx = _mm256_madd_epi16(td, _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_dx[r])));
+    t.dy = _mm256_madd_epi16(td, _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_dy[r])));
+    return t;
+}
+
 __attribute__((target("avx2"))) void mismatch(const cv::Mat &img, int x, int y, const Weights &w, const PrevWindow &pw,
                                               float &b1, float &b2)
 {
     const PairWeights pwt = pair_weights(w);
     const size_t step = img.step;
-    // each eight's differences as the b sums pair them: (k, k + 4, k, k + 4, k + 1, k + 5, ...)
-    const __m256i pair0 = _mm256_setr_epi8(0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11,  //
-                                           0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11);
-    const __m256i pair1 = _mm256_setr_epi8(4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15,  //
-                                           4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15);
     __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
     float s1 = 0.f, s2 = 0.f;  // the tail's sums, column after column
     alignas(32) float tx[8], ty[8];
     for (int r = 0; r < kWin; r++) {
-        const uchar *src = pixel(img, x, y + r);
-        const __m256i diff = _mm256_subs_epi16(image16(src, step, pwt),
-                                               _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.img[r])));
-        const __m256i p0 = _mm256_madd_epi16(_mm256_shuffle_epi8(diff, pair0),
-                                             _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.d10[r])));
-        const __m256i p1 = _mm256_madd_epi16(_mm256_shuffle_epi8(diff, pair1),
-                                             _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.d11[r])));
-        const __m256 f0 = _mm256_cvtepi32_ps(p0), f1 = _mm256_cvtepi32_ps(p1);
+        const RowTerms t = row_terms(pixel(img, x, y + r), step, pwt, pw, r);
+        const __m256 f0 = _mm256_cvtepi32_ps(t.p0), f1 = _mm256_cvtepi32_ps(t.p1);
         // OpenCV's order: the first eight, then the second
         qb0 = _mm_add_ps(qb0, _mm256_castps256_ps128(f0));
         qb1 = _mm_add_ps(qb1, _mm256_castps256_ps128(f1));
         qb0 = _mm_add_ps(qb0, _mm256_extractf128_ps(f0, 1));
         qb1 = _mm_add_ps(qb1, _mm256_extractf128_ps(f1, 1));
-        const __m256i td = _mm256_sub_epi32(image_tail(src, step, pwt),
-                                            _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_img[r])));
-        // madd's products: the derivatives' upper halves are zero
-        _mm256_store_ps(tx, _mm256_cvtepi32_ps(_mm256_madd_epi16(
-                                td, _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_dx[r])))));
-        _mm256_store_ps(ty, _mm256_cvtepi32_ps(_mm256_madd_epi16(
-                                td, _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_dy[r])))));
+        _mm256_store_ps(tx, _mm256_cvtepi32_ps(t.dx));
+        _mm256_store_ps(ty, _mm256_cvtepi32_ps(t.dy));
         for (int c = 0; c < kTail; c++) {
             s1 += tx[c];
             s2 += ty[c];
@@ -316,10 +327,6 @@ __attribute__((target("avx2"))) bool mismatch_exact(const cv::Mat &img, int x, i
 {
     const PairWeights pwt = pair_weights(w);
     const size_t step = img.step;
-    const __m256i pair0 = _mm256_setr_epi8(0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11,  //
-                                           0, 1, 8, 9, 0, 1, 8, 9, 2, 3, 10, 11, 2, 3, 10, 11);
-    const __m256i pair1 = _mm256_setr_epi8(4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15,  //
-                                           4, 5, 12, 13, 4, 5, 12, 13, 6, 7, 14, 15, 6, 7, 14, 15);
     const __m256i last = _mm256_set1_epi32(7);
     __m128i sum0 = _mm_setzero_si128(), sum1 = sum0;  // OpenCV's four-lane accumulators, as integers
     __m256i sumx = _mm256_setzero_si256(), sumy = sumx;  // the tail's sums, in every lane
@@ -327,13 +334,8 @@ __attribute__((target("avx2"))) bool mismatch_exact(const cv::Mat &img, int x, i
     __m128i seen = _mm_setzero_si128();
     __m256i seen8 = _mm256_setzero_si256();
     for (int r = 0; r < kWin; r++) {
-        const uchar *src = pixel(img, x, y + r);
-        const __m256i diff = _mm256_subs_epi16(image16(src, step, pwt),
-                                               _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.img[r])));
-        const __m256i p0 = _mm256_madd_epi16(_mm256_shuffle_epi8(diff, pair0),
-                                             _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.d10[r])));
-        const __m256i p1 = _mm256_madd_epi16(_mm256_shuffle_epi8(diff, pair1),
-                                             _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.d11[r])));
+        const RowTerms t = row_terms(pixel(img, x, y + r), step, pwt, pw, r);
+        const __m256i p0 = t.p0, p1 = t.p1;
         seen8 = _mm256_or_si256(seen8, _mm256_or_si256(_mm256_abs_epi32(p0), _mm256_abs_epi32(p1)));
         sum0 = _mm_add_epi32(sum0, _mm256_castsi256_si128(p0));
         sum1 = _mm_add_epi32(sum1, _mm256_castsi256_si128(p1));
@@ -341,11 +343,7 @@ __attribute__((target("avx2"))) bool mismatch_exact(const cv::Mat &img, int x, i
         sum0 = _mm_add_epi32(sum0, _mm256_extracti128_si256(p0, 1));
         sum1 = _mm_add_epi32(sum1, _mm256_extracti128_si256(p1, 1));
         seen = _mm_or_si128(seen, _mm_or_si128(_mm_abs_epi32(sum0), _mm_abs_epi32(sum1)));
-        const __m256i td = _mm256_sub_epi32(image_tail(src, step, pwt),
-                                            _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_img[r])));
-        // madd's products: the derivatives' upper halves are zero
-        const __m256i px = _mm256_madd_epi16(td, _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_dx[r])));
-        const __m256i py = _mm256_madd_epi16(td, _mm256_load_si256(reinterpret_cast<const __m256i *>(pw.tail_dy[r])));
+        const __m256i px = t.dx, py = t.dy;
         const __m256i run_x = running8(px, sumx), run_y = running8(py, sumy);
         seen8 = _mm256_or_si256(seen8, _mm256_or_si256(_mm256_abs_epi32(px), _mm256_abs_epi32(py)));
         seen8 = _mm256_or_si256(seen8, _mm256_or_si256(_mm256_abs_epi32(run_x), _mm256_abs_epi32(run_y)));
