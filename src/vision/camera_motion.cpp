@@ -1,6 +1,7 @@
 // camera_motion.cpp - background corners tracked by pyramidal Lucas-Kanade,
 // a RANSAC similarity per frame pair, chained to the first frame.
 #include "camera_motion.hpp"
+#include "cpu_avx2.hpp"
 #include "lk_track.hpp"
 
 #include <algorithm>
@@ -376,11 +377,6 @@ __attribute__((target("avx2"))) void column_eigen_avx2(double *sum, const double
     column_eigen_scalar(sum, P, M, w, E, i);
 }
 
-bool have_avx2()
-{
-    static const bool yes = __builtin_cpu_supports("avx2");
-    return yes;
-}
 #endif
 
 // the x in [x0, x1) where E[x] > thr and E[x] != 0 (a corner's first test), into xs; their count

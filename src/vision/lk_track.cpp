@@ -4,6 +4,7 @@
 // (OpenCV's four-lane accumulators chunk by chunk, its scalar sums over the
 // columns past the chunks, its lane reductions), so the same points and status.
 #include "lk_track.hpp"
+#include "cpu_avx2.hpp"
 
 #include <algorithm>
 #include <cfloat>
@@ -42,12 +43,6 @@ constexpr float kFltScale = 1.f / (1 << 20);
 constexpr int kMaxCount = 30;                 // TermCriteria COUNT
 constexpr double kEps2 = 0.01 * 0.01;         // TermCriteria EPS, squared as OpenCV squares it
 constexpr float kMinEig = static_cast<float>(1e-4);
-
-bool have_avx2()
-{
-    static const bool yes = __builtin_cpu_supports("avx2");
-    return yes;
-}
 
 // (x, y) of a level, which may lie in its border (Mat::ptr asserts rows inside)
 inline const uchar *pixel(const cv::Mat &m, int x, int y)

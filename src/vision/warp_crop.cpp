@@ -4,6 +4,7 @@
 // reads across many source rows, which the hardware prefetcher does not follow);
 // and blobFromImage's float RGB planes of the crop in one pass.
 #include "warp_crop.hpp"
+#include "cpu_avx2.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -53,12 +54,6 @@ const WeightTable &weights()
 {
     static const WeightTable t;
     return t;
-}
-
-bool have_avx2()
-{
-    static const bool yes = __builtin_cpu_supports("avx2");
-    return yes;
 }
 
 inline int clip(int v, int n) { return v >= 0 ? (v < n ? v : n - 1) : 0; }
