@@ -54,7 +54,7 @@ case $profile_file in /*) ;; *) profile_file=$(pwd)/$profile_file ;; esac
 # the same selection for the host twin (cc -D...)
 twin_defs=""
 for f in $features; do twin_defs="$twin_defs -D$f"; done
-[ "$profile" = OFF ] && twin_defs="$twin_defs -DFW_PROFILE_BAKED=1"
+[ "$profile" = OFF ] && twin_defs="$twin_defs -DFW_PROFILE_BAKED=1 -DGS_BAKED_PROFILE=1"
 echo "--- device ${GS_FW_DEVICE:-all}: features off: ${features:-none}; profile $(basename "$profile_file") parsed at boot: $profile (OFF: baked)"
 # build_fw DIR LTO: configure and build the firmware in DIR
 build_fw() {

@@ -53,28 +53,32 @@ typedef struct {
     float c[GS_SEG_COUNT];
 } seg_table;
 
-static const seg_table k_tables[3] = {
-    /* de Leva P. (1996) Adjustments to Zatsiorsky-Seluyanov's segment inertia
-     * parameters. J Biomech 29:1223-30, Table 4, mean of male and female columns.
-     * Trunk SUPR->MIDH (0.4486 M, 0.4151 F); hand 0.79/0.747 of WJC->MET3 turned
-     * into forearm lengths; foot HEEL->TTIP. Female shank/hand values from memory. */
-    { { 6.81f, 43.015f, 2.63f, 1.50f, 0.585f, 14.47f, 4.57f, 1.33f },
-      { 0.0f, 0.4319f, 0.5763f, 0.4567f, 0.24f, 0.3854f, 0.4438f, 0.4215f } },
-    /* Clauser C.E., McConville J.T., Young J.W. (1969) Weight, volume and centre
-     * of mass of segments of the human body. AMRL-TR-69-70, mean of 13 cadavers.
-     * Trunk COM 38.0 % of trunk length read from the hip end (see the doc: read
-     * from the top it puts the standing COM at 0.60 of stature); hand 18 % of
-     * hand length = 0.13 forearm lengths beyond the wrist. */
-    { { 7.3f, 50.7f, 2.6f, 1.6f, 0.7f, 10.3f, 4.3f, 1.5f },
-      { 0.0f, 0.6197f, 0.513f, 0.390f, 0.13f, 0.372f, 0.371f, 0.449f } },
-    /* Dempster W.T. (1955) Space requirements of the seated operator, WADC-TR-55-159,
-     * as tabulated by Winter D.A., Biomechanics and Motor Control of Human Movement,
-     * Table 4.1. Head+neck COM at the ear canal; trunk glenohumeral -> trochanter 0.50;
-     * hand 0.506 of wrist -> middle-finger knuckle = 0.27 forearm lengths;
-     * foot 0.50 of malleolus -> metatarsal II, used as 0.50 heel -> toe. */
-    { { 8.1f, 49.7f, 2.8f, 1.6f, 0.6f, 10.0f, 4.65f, 1.45f },
-      { 0.0f, 0.50f, 0.436f, 0.430f, 0.27f, 0.433f, 0.433f, 0.50f } },
-};
+/* de Leva P. (1996) Adjustments to Zatsiorsky-Seluyanov's segment inertia
+ * parameters. J Biomech 29:1223-30, Table 4, mean of male and female columns.
+ * Trunk SUPR->MIDH (0.4486 M, 0.4151 F); hand 0.79/0.747 of WJC->MET3 turned
+ * into forearm lengths; foot HEEL->TTIP. Female shank/hand values from memory. */
+static const seg_table k_deleva = {
+    { 6.81f, 43.015f, 2.63f, 1.50f, 0.585f, 14.47f, 4.57f, 1.33f },
+    { 0.0f, 0.4319f, 0.5763f, 0.4567f, 0.24f, 0.3854f, 0.4438f, 0.4215f } };
+/* Clauser C.E., McConville J.T., Young J.W. (1969) Weight, volume and centre
+ * of mass of segments of the human body. AMRL-TR-69-70, mean of 13 cadavers.
+ * Trunk COM 38.0 % of trunk length read from the hip end (see the doc: read
+ * from the top it puts the standing COM at 0.60 of stature); hand 18 % of
+ * hand length = 0.13 forearm lengths beyond the wrist. */
+static const seg_table k_clauser = {
+    { 7.3f, 50.7f, 2.6f, 1.6f, 0.7f, 10.3f, 4.3f, 1.5f },
+    { 0.0f, 0.6197f, 0.513f, 0.390f, 0.13f, 0.372f, 0.371f, 0.449f } };
+/* Dempster W.T. (1955) Space requirements of the seated operator, WADC-TR-55-159,
+ * as tabulated by Winter D.A., Biomechanics and Motor Control of Human Movement,
+ * Table 4.1. Head+neck COM at the ear canal; trunk glenohumeral -> trochanter 0.50;
+ * hand 0.506 of wrist -> middle-finger knuckle = 0.27 forearm lengths;
+ * foot 0.50 of malleolus -> metatarsal II, used as 0.50 heel -> toe. */
+static const seg_table k_dempster = {
+    { 8.1f, 49.7f, 2.8f, 1.6f, 0.6f, 10.0f, 4.65f, 1.45f },
+    { 0.0f, 0.50f, 0.436f, 0.430f, 0.27f, 0.433f, 0.433f, 0.50f } };
+/* by gs_mass_table; one object each, so a build whose table is a constant (a baked
+ * profile) keeps only its own */
+static const seg_table *const k_tables[3] = {&k_deleva, &k_clauser, &k_dempster};
 
 /* ---- model constants (see docs/anthropometry.md) ---------------------------- */
 
@@ -648,7 +652,7 @@ float gs_mass_fraction(gs_mass_table t, gs_segment s)
     if ((unsigned)t > (unsigned)GS_MASS_DEMPSTER || (unsigned)s >= (unsigned)GS_SEG_COUNT) {
         return NAN;
     }
-    const seg_table *tb = &k_tables[t];
+    const seg_table *tb = k_tables[t];
     return tb->mass_pct[s] / table_total_pct(tb);
 }
 
@@ -779,7 +783,7 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         return GS_OK;
     }
 #if GS_WITH_POSE
-    skeleton_com(layout, &k_tables[table], stature, min_conf, kp, out);
+    skeleton_com(layout, k_tables[table], stature, min_conf, kp, out);
 #endif
     return GS_OK;
 }

@@ -34,6 +34,7 @@
 #define DBG(...) ((void)0)
 #endif
 
+#include "gs_cfg_in.h"
 #include "gs_finite.h"
 #include "gs_inline.h"
 #include "gs_median.h"
@@ -41,6 +42,7 @@
 
 
 /* tuning: thresholds in units of the noise or of the object's size */
+#define CFG(f) GS_CFG_IN((f)->cfg)  /* gs_cfg_in.h: a constant where the profile is baked */
 #define USABLE_W_MIN     0.05f  /* lighter frames are left out of flight detection */
 #define SEED_RISE_REL    GS_R(0.03)   /* apex must rise this x size above the recent minimum */
 #define SEED_RISE_NOISE  GS_R(8.0)    /* ... and this x noise */
@@ -326,7 +328,7 @@ static bool span_cfg_us(float s, int32_t *span_us)
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
-    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP) return GS_EINVAL;
+    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP || !gs_cfg_is_baked(cfg)) return GS_EINVAL;
     memset(f, 0, sizeof *f);  /* (GS_FS_IDLE, no frame interval, no feet, no close pending) */
     f->cfg = cfg;
     f->ring = ring;
@@ -334,6 +336,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     f->rigid = rigid;
     f->on_event = on_event;
     f->ctx = ctx;
+    cfg = GS_CFG_IN(cfg);
     f->g_m_s2 = gs_core_config_g(cfg);
     /* the configured spans into f's four span fields, in turn */
     static const uint8_t span_cfg[4] = {offsetof(gs_core_config, min_flight_s), offsetof(gs_core_config, max_flight_s),
@@ -538,8 +541,8 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
     gs_real a_min = -(gs_real)INFINITY, a_max = (gs_real)INFINITY;  /* no size, no flight yet: any */
     if (finite_r(size_px) && size_px > GS_R(0.0)) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
-        a_min = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_max_m * EMIT_FACTOR);
-        a_max = size_px * f->g_m_s2 / ((gs_real)f->cfg->size_min_m / EMIT_FACTOR);
+        a_min = size_px * f->g_m_s2 / ((gs_real)CFG(f)->size_max_m * EMIT_FACTOR);
+        a_max = size_px * f->g_m_s2 / ((gs_real)CFG(f)->size_min_m / EMIT_FACTOR);
     } else if (finite_r(f->last_a_px_s2)) {
         a_min = f->last_a_px_s2 / EMIT_FACTOR;
         a_max = f->last_a_px_s2 * EMIT_FACTOR;
@@ -612,7 +615,7 @@ static bool gravity_agrees(const gs_flight *f, const gs_fit_result *r)
  * body's (a jump in place drifts a few cm/s; a stride travels metres a second) */
 static bool running_stride(const gs_flight *f, const gs_fit_result *r, uint32_t n, bool feet, gs_real size_px)
 {
-    if (IS_RIGID(f) || feet || n >= 2u * f->cfg->min_samples) return false;
+    if (IS_RIGID(f) || feet || n >= 2u * CFG(f)->min_samples) return false;
     gs_real gx = r->ax_px_s2 / r->a_px_s2, gy = r->ay_px_s2 / r->a_px_s2;
     gs_real v_across = GS_FABSR(r->vx_px_s * gy - r->vy_px_s * gx);  /* perpendicular to gravity */
     return v_across > STRIDE_REL * size_px;
@@ -1383,7 +1386,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
     uint32_t count = (uint32_t)(in_hi - in_lo + 1);
     gs_fit_result fr;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    gs_status st = robust_fit(f, m, in_lo, count, f->cfg->fit_method, min_scale, &fr);
+    gs_status st = robust_fit(f, m, in_lo, count, CFG(f)->fit_method, min_scale, &fr);
     trace_fit(f, "final", sf->t_us, sl->t_us, st == GS_OK ? &fr : NULL);
     if (st != GS_OK) goto done;  /* nothing fits: not a flight worth reporting */
 
@@ -1486,19 +1489,19 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             j->reason = GS_REJ_FALL;
         else if (GS_WITH_POSE && c->feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;
-        else if (n_in < f->cfg->min_samples || T1_us - T0_us < f->min_flight_us)
+        else if (n_in < CFG(f)->min_samples || T1_us - T0_us < f->min_flight_us)
             j->reason = GS_REJ_FEW_SAMPLES;
         else if (max_gap_in > f->max_gap_us)
             j->reason = GS_REJ_GAP;
         else if (!finite_r(size) && !sizeless_ok)
             j->reason = GS_REJ_NO_SIZE;
-        else if (fr.rms_px > (gs_real)f->cfg->max_rms_rel * gsize)
+        else if (fr.rms_px > (gs_real)CFG(f)->max_rms_rel * gsize)
             j->reason = GS_REJ_LARGE_RESIDUAL;
-        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)f->cfg->max_a_se_rel) || running_stride(f, &fr, n_in, feet, gsize))
+        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)CFG(f)->max_a_se_rel) || running_stride(f, &fr, n_in, feet, gsize))
             j->reason = GS_REJ_UNCERTAIN_A;
         else if (!gravity_agrees(f, &fr))
             j->reason = GS_REJ_GRAVITY_DIR;
-        else if (finite_r(height) && (height < (gs_real)f->cfg->size_min_m || height > (gs_real)f->cfg->size_max_m))
+        else if (finite_r(height) && (height < (gs_real)CFG(f)->size_min_m || height > (gs_real)CFG(f)->size_max_m))
             j->reason = GS_REJ_IMPLAUSIBLE_A;
         j->accepted = j->reason == GS_REJ_NONE;
         /* the same posture at both ends puts the COM at the same height (feet times only) */
@@ -1507,7 +1510,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             if (GS_FABSR(du) > COM_MISMATCH_REL * gsize) warn |= GS_WARN_COM_MISMATCH;
         }
 
-        if (n_in < 2u * f->cfg->min_samples) warn |= GS_WARN_FEW_SAMPLES;
+        if (n_in < 2u * CFG(f)->min_samples) warn |= GS_WARN_FEW_SAMPLES;
         if (n_out * 5u > n_in) warn |= GS_WARN_OUTLIERS;
         if (c->truncated) warn |= GS_WARN_CLIPPED;
         if (GS_FABSR(fr.g_dir_deg - f->last_g_dir_deg) > GS_R(10.0))  /* (NaN before an accepted flight) */
@@ -1609,7 +1612,7 @@ static void close_begin(gs_flight *f, gs_close *c, uint32_t newest, uint32_t rig
 static void up_turn_max(const gs_flight *f, gs_real *cos_out, gs_real *sin_out)
 {
     gs_real cap = GS_R(80.0) * GS_PI / GS_R(180.0);
-    gs_real lim = GRAV_DIR_SE_K * (gs_real)f->cfg->max_a_se_rel + GRAV_DIR_MIN_DEG * GS_PI / GS_R(180.0);
+    gs_real lim = GRAV_DIR_SE_K * (gs_real)CFG(f)->max_a_se_rel + GRAV_DIR_MIN_DEG * GS_PI / GS_R(180.0);
     gs_real th = (f->up_from_flight || f->up_n > 0) && lim < cap ? lim : cap;
     gs_real c = (gs_real)GS_COS(th + GS_R(1e-3)), s = (gs_real)GS_SIN(th + GS_R(1e-3));
     if (f->up_from_flight) {

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "gs_cfg_in.h"
 #include "gs_dbits.h"
 #include "gs_finite.h"
 
@@ -196,7 +197,8 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
 gs_status gs_pipeline_com(const gs_pipeline *p, const gs_kp *kp, gs_com_out *com)
 {
     if (!p || !kp || !com) return GS_EINVAL;
-    return gs_com_compute(p->layout, p->cfg.mass_table, p->cfg.stature, p->cfg.min_conf, kp, com);
+    const gs_core_config *c = GS_CFG_IN(&p->cfg);
+    return gs_com_compute(p->layout, c->mass_table, c->stature, c->min_conf, kp, com);
 }
 
 gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp, const gs_com_out *com)
@@ -214,7 +216,7 @@ gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp,
     float feet[2 * GS_FEET_POINTS];  /* x then y of each point, NaN missing */
     for (int k = 0; k < GS_FEET_POINTS; k++) {
         const gs_kp *f = &kp[k_feet_kp[p->layout][k]];
-        bool seen = !is_point(p->layout) && f->c >= p->cfg.min_conf && f->c > 0.0f;
+        bool seen = !is_point(p->layout) && f->c >= GS_CFG_IN(&p->cfg)->min_conf && f->c > 0.0f;
         feet[k] = seen ? f->x_px : NAN;
         feet[GS_FEET_POINTS + k] = seen ? f->y_px : NAN;
     }

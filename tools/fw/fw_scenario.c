@@ -26,12 +26,17 @@ static uint32_t g_status;
 
 #ifndef FW_PROFILE_BAKED
 static const char k_profile[] = FW_PROFILE_TEXT;
+#define FW_FORMAT g_cfg.format
+#else
+/* checked at build time: no text parser linked */
+static const gs_core_config k_baked = FW_PROFILE_CONFIG;
+#define FW_FORMAT k_baked.format  /* a constant: the emitter keeps only its format */
 #endif
 
 static void on_event(void *ctx, const gs_event *ev)
 {
     (void)ctx;
-    size_t n = gs_emit(g_cfg.format, ev, g_line, sizeof g_line);
+    size_t n = gs_emit(FW_FORMAT, ev, g_line, sizeof g_line);
     if (n > 0 && g_sink) g_sink(g_line, n);
 }
 
@@ -95,8 +100,6 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     gs_core_config_default(&g_cfg);
     g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
 #else
-    /* checked at build time: no text parser linked */
-    static const gs_core_config k_baked = FW_PROFILE_CONFIG;
     g_cfg = k_baked;
     g_status = 0;
 #endif
