@@ -34,7 +34,9 @@ typedef struct {
 /* Bytes of storage gs_pipeline_init needs for cfg->ring_capacity. */
 size_t gs_pipeline_storage_bytes(const gs_core_config *cfg);
 
-/* storage: at least gs_pipeline_storage_bytes(cfg) bytes, aligned for double. */
+/* storage: at least gs_pipeline_storage_bytes(cfg) bytes, aligned for double. A core
+ * built with its profile baked in (GS_BAKED_PROFILE, docs/firmware.md) takes only that
+ * profile: any other cfg gives GS_EINVAL. */
 gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout layout,
                            void *storage, size_t storage_bytes,
                            gs_event_fn on_event, void *ctx);
