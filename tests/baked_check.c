@@ -42,9 +42,7 @@ static int check_refusal(void)
 int main(void)
 {
     int fail = check_refusal();
-    unsigned st = fw_scenario_run(false, on_line);
-    fputs("--- pose\n", stdout);
-    st |= fw_scenario_run(true, on_line);
+    unsigned st = fw_scenario_run_both(on_line);
     if (st != 0u) fprintf(stderr, "baked_check: the workload's status %u\n", st);
     return fail || st != 0u;
 }

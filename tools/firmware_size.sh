@@ -143,12 +143,12 @@ else
 fi
 # RAM: the ring, the rest of the core's state, and what the app adds
 sym_size() { arm-none-eabi-nm -S -t d "$elf" | awk -v s="$1" '$4 == s {print $2 + 0}'; }
-storage=$(sym_size g_storage); pipe=$(sym_size g_pipe); cfg=$(sym_size g_cfg); line=$(( $(sym_size g_line) + $(sym_size g_last) ))
+storage=$(sym_size g_storage); pipe=$(sym_size g_pipe); cfg=$(sym_size g_cfg); cfg=${cfg:-0}; line=$(( $(sym_size g_line) + $(sym_size g_last) ))
 ring=$((RING_SAMPLES * 16))
 state=$((pipe + storage - ring))
 echo "ram  ring ($RING_SAMPLES x 16 B)       : $ring B"
 echo "ram  state (gs_pipeline $pipe B + inlier bits $((storage - ring)) B): $state B; budget <= $STATE_BUDGET B"
-echo "ram  app (line buffers $line B, config copy $cfg B), .data+.bss total $((data + bss)) B incl. the stack reserve"
+echo "ram  app (line buffers $line B, parsed profile $cfg B: none when baked), .data+.bss total $((data + bss)) B incl. the stack reserve"
 if [ "$state" -gt "$STATE_BUDGET" ] || [ "$storage" -lt "$ring" ]; then
   echo "FAIL state over budget"; fail=1
 else

@@ -12,8 +12,5 @@ static void on_line(const char *line, size_t len)
 
 int main(void)
 {
-    unsigned st = fw_scenario_run(false, on_line);
-    fputs("--- pose\n", stdout);
-    st |= fw_scenario_run(true, on_line);
-    return st == 0u ? 0 : 1;
+    return fw_scenario_run_both(on_line) == 0u ? 0 : 1;
 }

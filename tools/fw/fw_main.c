@@ -44,11 +44,11 @@ static void on_line(const char *line, size_t len)
 
 int main(void)
 {
+#ifndef FW_SEMIHOST
     g_status = fw_scenario_run(g_use_pose != 0u, on_line);
-#ifdef FW_SEMIHOST
+#else
     /* both paths when run under a debugger: the ball, then the skeleton */
-    semihost(0x04u, "--- pose\n");
-    g_status |= fw_scenario_run(true, on_line);
+    g_status = fw_scenario_run_both(on_line);
     {
         /* stack high-water mark: the reset handler painted the reserve */
         const uint32_t *p = &_sstack_reserve;

@@ -19,16 +19,16 @@
 #define FW_STORAGE_BYTES (FW_RING_CAP * sizeof(gs_sample) + (FW_RING_CAP + 31u) / 32u * 4u)
 static uint64_t g_storage[(FW_STORAGE_BYTES + 7u) / 8u];  /* 8-byte aligned */
 static gs_pipeline g_pipe;
-static gs_core_config g_cfg;
 static char g_line[GS_EMIT_MAX];
 static fw_line_fn g_sink;
 static uint32_t g_status;
 
 #ifndef FW_PROFILE_BAKED
 static const char k_profile[] = FW_PROFILE_TEXT;
+static gs_core_config g_cfg;  /* parsed at boot */
 #define FW_FORMAT g_cfg.format
 #else
-/* checked at build time: no text parser linked */
+/* checked at build time: no text parser linked, no copy in RAM */
 static const gs_core_config k_baked = FW_PROFILE_CONFIG;
 #define FW_FORMAT k_baked.format  /* a constant: the emitter keeps only its format */
 #endif
@@ -99,8 +99,9 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     const gs_cfg_section sec = {"core", gs_core_config_set, &g_cfg};
     gs_core_config_default(&g_cfg);
     g_status = (uint32_t)gs_cfg_parse(k_profile, sizeof k_profile - 1u, &sec, 1, &err);
+    const gs_core_config *cfg = &g_cfg;
 #else
-    g_cfg = k_baked;
+    const gs_core_config *cfg = &k_baked;
     g_status = 0;
 #endif
     if (!pose && !GS_WITH_POINT) return 0u; /* no point layout built in: no ball workload */
@@ -110,7 +111,7 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     if (pose) return 0u; /* no skeleton layout built in: no skeleton workload */
     const gs_layout layout = GS_LAYOUT_POINT;
 #endif
-    g_status |= (uint32_t)gs_pipeline_init(&g_pipe, &g_cfg, layout,
+    g_status |= (uint32_t)gs_pipeline_init(&g_pipe, cfg, layout,
                                            g_storage, sizeof g_storage, on_event, NULL);
     const float q_m_per_px = 0.002f;
     for (uint32_t i = 0; i < 6u * FW_FPS; i++) {
@@ -128,4 +129,12 @@ uint32_t fw_scenario_run(bool pose, fw_line_fn line)
     }
     g_status |= (uint32_t)gs_pipeline_flush(&g_pipe);
     return g_status;
+}
+
+uint32_t fw_scenario_run_both(fw_line_fn line)
+{
+    static const char k_sep[] = "--- pose\n";
+    uint32_t st = fw_scenario_run(false, line);
+    line(k_sep, sizeof k_sep - 1u);
+    return st | fw_scenario_run(true, line);
 }

@@ -15,4 +15,7 @@ typedef void (*fw_line_fn)(const char *line, size_t len);
  * 60 fps, flush. Returns the OR of every status (0 = all GS_OK). */
 uint32_t fw_scenario_run(bool pose, fw_line_fn line);
 
+/* The ball, a line "--- pose", then the skeleton: what the host twin and QEMU print. */
+uint32_t fw_scenario_run_both(fw_line_fn line);
+
 #endif
