@@ -139,7 +139,7 @@ typedef struct {
     bool up_from_flight;       /* set from fitted flights (else body axis or image up) */
 
     gs_real noise_px;          /* robust COM noise (1 axis), from ground phases; NaN until known */
-    float noise_init[9];       /* first |second differences| (NOISE_INIT_N) */
+    float noise_init[9];       /* first |second differences| (NOISE_INIT_N; sorted once their median is taken) */
     uint32_t noise_n;
     gs_real u_hist[3];         /* last three u of valid samples (for a median of 3) */
     uint32_t i_hist[3];

@@ -891,7 +891,8 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int32
 {
     /* called per boundary candidate and sample: gs_real. In float, u is taken about
      * the first sample's (the SSR below is yy - c.b, which cancels), in gs_real as is */
-    gs_real A[4][4] = {{0}}, b[4] = {0}, yy = GS_R(0.0);
+    struct { gs_real A[4][4], b[4]; } ne = {0};  /* the normal equations A c = b, zeroed at once */
+    gs_real yy = GS_R(0.0);
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
     /* tau in [-1, 1] over [t_lo, t_hi]: centre tc, half-width ts */
@@ -912,12 +913,12 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int32
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
         gs_real u = (gs_real)u_of(f, s) - u_c;
         for (int k = 0; k < 4; k++) {
-            b[k] += w * x[k] * u;
-            for (int m = 0; m < 4; m++) A[k][m] += w * x[k] * x[m];
+            ne.b[k] += w * x[k] * u;
+            for (int m = 0; m < 4; m++) ne.A[k][m] += w * x[k] * x[m];
         }
         yy += w * u * u;
     }
-    return pw_ssr_solve(A, b, yy, alpha_min_px * ts2, alpha_max_px * ts2);  /* alpha in tau units */
+    return pw_ssr_solve(ne.A, ne.b, yy, alpha_min_px * ts2, alpha_max_px * ts2);  /* alpha in tau units */
 }
 
 #ifndef __OPTIMIZE_SIZE__
@@ -1906,10 +1907,8 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
         f->noise_init[f->noise_n++] = (float)GS_FABSR(d2);
-        if (f->noise_n == NOISE_INIT_N) {
-            float tmp[NOISE_INIT_N];
-            memcpy(tmp, f->noise_init, sizeof tmp);
-            gs_real med = median_f(tmp, NOISE_INIT_N);
+        if (f->noise_n == NOISE_INIT_N) {  /* (their order is not needed again: sorted in place) */
+            gs_real med = median_f(f->noise_init, NOISE_INIT_N);
             f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = 1.652 s */
             if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
         }
