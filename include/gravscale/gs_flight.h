@@ -139,7 +139,7 @@ typedef struct {
     bool up_from_flight;       /* set from fitted flights (else body axis or image up) */
 
     gs_real noise_px;          /* robust COM noise (1 axis), from ground phases; NaN until known */
-    float noise_init[9];       /* first |second differences| (NOISE_INIT_N) */
+    float noise_init[9];       /* first |second differences| (NOISE_INIT_N; sorted once their median is taken) */
     uint32_t noise_n;
     gs_real u_hist[3];         /* last three u of valid samples (for a median of 3) */
     uint32_t i_hist[3];
@@ -190,7 +190,9 @@ typedef struct {
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx);
 /* Time flights by the feet: two foot points per frame (gs_flight_feet), lifting delta_rel
- * x stature above their rest when the foot leaves; stop_touch: see gs_feet.h. */
+ * x stature above their rest when the foot leaves; stop_touch: see gs_feet.h. A build
+ * without the point layout (gs_features.h) tracks bodies only and times every flight by the
+ * feet: call this after gs_flight_init (gs_pipeline does). */
 void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch);
 /* The frame at t_us's two foot points (NaN missing) and the body's size this frame (NaN
  * unknown), before the frame's sample is examined (gs_flight_update). */

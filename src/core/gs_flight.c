@@ -43,6 +43,8 @@
 
 /* tuning: thresholds in units of the noise or of the object's size */
 #define CFG(f) GS_CFG_IN((f)->cfg)  /* gs_cfg_in.h: a constant where the profile is baked */
+/* the feet time the flights: always where no point layout is built (every object is a body) */
+#define FEET_ON(f) (!GS_WITH_POINT || (f)->feet_on)
 #define USABLE_W_MIN     0.05f  /* lighter frames are left out of flight detection */
 #define SEED_RISE_REL    GS_R(0.03)   /* apex must rise this x size above the recent minimum */
 #define SEED_RISE_NOISE  GS_R(8.0)    /* ... and this x noise */
@@ -398,7 +400,7 @@ static __attribute__((cold, noinline)) void feet_hold(gs_flight *f, int64_t t_us
 void gs_flight_feet(gs_flight *f, int64_t t_us, const float x_px[GS_FEET_POINTS],
                     const float y_px[GS_FEET_POINTS], float size_px)
 {
-    if (!GS_WITH_POSE || !f || !f->feet_on) return;
+    if (!GS_WITH_POSE || !f || !FEET_ON(f)) return;
 #if GS_CLOSE_LAG_FRAMES > 0
     if (f->close.stage != GS_CLOSE_NONE) {
         feet_hold(f, t_us, x_px, y_px, size_px);
@@ -473,12 +475,13 @@ static const gs_sample_full *tested_at(const gs_flight *f, const gs_fit_result *
     return s && test_sample(f, r, s, z) ? s : NULL;
 }
 
-/* one-sided CUSUM of z: contact raises it, noise drains it */
-static NOINLINE gs_real cusum_step(gs_real S, gs_real z)
+/* one-sided CUSUM of z: contact raises it, noise drains it. True: its alarm (contact) */
+static NOINLINE bool cusum_step(gs_real *S, gs_real z)
 {
-    if (z > CUSUM_ZMAX) z = CUSUM_ZMAX;
-    S += z - CUSUM_K;
-    return S > GS_R(0.0) ? S : GS_R(0.0);
+    gs_real zc = z > CUSUM_ZMAX ? CUSUM_ZMAX : z;
+    gs_real s = *S + (zc - CUSUM_K);
+    *S = s > GS_R(0.0) ? s : GS_R(0.0);
+    return *S > CUSUM_H && z > CUSUM_K;
 }
 
 /* typical frame interval from the history (for time-based spans), 1/16 us */
@@ -888,7 +891,8 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int32
 {
     /* called per boundary candidate and sample: gs_real. In float, u is taken about
      * the first sample's (the SSR below is yy - c.b, which cancels), in gs_real as is */
-    gs_real A[4][4] = {{0}}, b[4] = {0}, yy = GS_R(0.0);
+    struct { gs_real A[4][4], b[4]; } ne = {0};  /* the normal equations A c = b, zeroed at once */
+    gs_real yy = GS_R(0.0);
     gs_real u_c = GS_R(0.0);
     bool have_c = sizeof(gs_real) == sizeof(double);
     /* tau in [-1, 1] over [t_lo, t_hi]: centre tc, half-width ts */
@@ -909,12 +913,12 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int32
         if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
         gs_real u = (gs_real)u_of(f, s) - u_c;
         for (int k = 0; k < 4; k++) {
-            b[k] += w * x[k] * u;
-            for (int m = 0; m < 4; m++) A[k][m] += w * x[k] * x[m];
+            ne.b[k] += w * x[k] * u;
+            for (int m = 0; m < 4; m++) ne.A[k][m] += w * x[k] * x[m];
         }
         yy += w * u * u;
     }
-    return pw_ssr_solve(A, b, yy, alpha_min_px * ts2, alpha_max_px * ts2);  /* alpha in tau units */
+    return pw_ssr_solve(ne.A, ne.b, yy, alpha_min_px * ts2, alpha_max_px * ts2);  /* alpha in tau units */
 }
 
 #ifndef __OPTIMIZE_SIZE__
@@ -1133,8 +1137,7 @@ static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, 
                 continue;
             }
             c->outliers = 0;
-            c->cusum = cusum_step(c->cusum, z);
-            if (!(c->cusum > CUSUM_H && z > CUSUM_K)) {
+            if (!cusum_step(&c->cusum, z)) {
                 fit_add(f, s);
                 gs_fit_solve(&f->fit, &c->r);
                 if (c->cusum == GS_R(0.0)) c->clean = i;
@@ -1310,7 +1313,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         c->feet_contradict = false;  /* the feet, in view, show no flight there */
         c->fell = false;             /* ... or a fall to a lower floor */
     }
-    if (GS_WITH_POSE && f->feet_on && falls) {
+    if (GS_WITH_POSE && FEET_ON(f) && falls) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
         int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
@@ -1436,6 +1439,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
     j->size_px = size;
+    const gs_real size_measured = size;  /* (size itself is dropped where the depth changed) */
     uint32_t warn = 0;  /* j->warnings, set once */
 
     {
@@ -1468,16 +1472,17 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             size = size_se = NAN;
             j->size_px = NAN;
         }
+        gs_real ra = fr.a_se_px_s2 / fr.a_px_s2;  /* the acceleration's relative SE */
         if (finite_r(size)) {
             height = size * q;
             j->height_m = height;
-            gs_real ra = fr.a_se_px_s2 / fr.a_px_s2;
             gs_real rs = finite_r(size_se) ? size_se / size : GS_R(0.0);
             j->height_se_m = height * GS_SQRT((finite_r(ra) ? ra * ra : GS_R(0.0)) + rs * rs);
         }
 
-        /* is this a flight at all? (walking bumps, standing, noise) */
-        gs_real gsize = finite_r(size) ? size : gate_size(f, in_lo);
+        /* is this a flight at all? (walking bumps, standing, noise) A body's gating size is
+         * its standing size, even where the depth left it unused */
+        gs_real gsize = !IS_RIGID(f) ? size_measured : finite_r(size) ? size : gate_size(f, in_lo);
         bool flight_like = plausible_fall(f, &fr, gsize);
         if (!flight_like) goto done;
         f->last_land_us = F1 != GS_LT_NONE ? abs_of(f, F1) : T1_us;  /* (a fall's landing is the feet's, for the rebound's contact) */
@@ -1497,7 +1502,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
             j->reason = GS_REJ_NO_SIZE;
         else if (fr.rms_px > (gs_real)CFG(f)->max_rms_rel * gsize)
             j->reason = GS_REJ_LARGE_RESIDUAL;
-        else if (!(fr.a_se_px_s2 / fr.a_px_s2 <= (gs_real)CFG(f)->max_a_se_rel) || running_stride(f, &fr, n_in, feet, gsize))
+        else if (!(ra <= (gs_real)CFG(f)->max_a_se_rel) || running_stride(f, &fr, n_in, feet, gsize))
             j->reason = GS_REJ_UNCERTAIN_A;
         else if (!gravity_agrees(f, &fr))
             j->reason = GS_REJ_GRAVITY_DIR;
@@ -1812,7 +1817,7 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     if (!(s->upright >= STAND_UPRIGHT)) return;
     if (s->t_us - f->still_since_us < STAND_SETTLE_US) return;  /* settled, not rising onto the toes */
     /* sizes are kept for one place: where the feet stand on another floor row, afresh */
-    float floor = GS_WITH_POSE && f->feet_on ? gs_feet_floor_px(&f->feet) : NAN;
+    float floor = GS_WITH_POSE && FEET_ON(f) ? gs_feet_floor_px(&f->feet) : NAN;
     if (floor == floor) {
         bool same = f->stand_floor_epoch == f->feet.epoch && f->stand_floor_px == f->stand_floor_px;
         if (!same || GS_FABSR((gs_real)(floor - f->stand_floor_px)) > DEPTH_TOL_REL * (gs_real)s->size_px) {
@@ -1847,7 +1852,7 @@ gs_real gs_flight_stand_at(const gs_flight *f, int64_t t_us)
     return (gs_real)last_stand_size(f);
 }
 
-void gs_flight_forget_body(gs_flight *f)
+NOINLINE void gs_flight_forget_body(gs_flight *f)  /* (one copy for init and the pipeline) */
 {
     if (!f) return;
 #if GS_CLOSE_LAG_FRAMES > 0
@@ -1902,10 +1907,8 @@ static void ground_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
      * the median of the first few (one early glitch must not set it) */
     if (f->noise_n < NOISE_INIT_N) {
         f->noise_init[f->noise_n++] = (float)GS_FABSR(d2);
-        if (f->noise_n == NOISE_INIT_N) {
-            float tmp[NOISE_INIT_N];
-            memcpy(tmp, f->noise_init, sizeof tmp);
-            gs_real med = median_f(tmp, NOISE_INIT_N);
+        if (f->noise_n == NOISE_INIT_N) {  /* (their order is not needed again: sorted in place) */
+            gs_real med = median_f(f->noise_init, NOISE_INIT_N);
             f->noise_px = med / GS_R(1.652);  /* median |N(0, 6 s^2)| = 1.652 s */
             if (f->noise_px < GS_R(0.05)) f->noise_px = GS_R(0.05);
         }
@@ -1956,7 +1959,7 @@ static void land(gs_flight *f, uint32_t idx, uint32_t alarm, const gs_sample_ful
     /* the COM may turn before the feet meet the floor (its model is not the body): while a
      * foot that left is still in the air, wait for it a little (the event still leaves well
      * within the landing latency) */
-    if (GS_WITH_POSE && f->feet_on && f->feet_wait_us == GS_T_NONE && gs_feet_airborne(&f->feet)) {
+    if (GS_WITH_POSE && FEET_ON(f) && f->feet_wait_us == GS_T_NONE && gs_feet_airborne(&f->feet)) {
         f->feet_wait_us = s->t_us + FEET_WAIT_US;
         f->wait_alarm = alarm;
         return;
@@ -2004,12 +2007,12 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
         return;
     }
     f->outliers_run = 0;
-    f->cusum = cusum_step(f->cusum, z);
+    bool contact = cusum_step(&f->cusum, z);
     alarm = idx;
     /* deviations that persist for the configured latency end the flight, alarm or not */
     if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us))
         goto landed;
-    if (f->cusum > CUSUM_H && z > CUSUM_K) {  /* decelerated by the ground: landed? */
+    if (contact) {  /* decelerated by the ground: landed? */
         fit_memo m = {0};
         if (!alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) goto landed;
         f->fl_last = idx;   /* the refit took every sample through idx */
@@ -2131,7 +2134,7 @@ void gs_flight_update(gs_flight *f)
 /* the stream ends or pauses: close an open candidate (one waiting for its feet with its alarm) */
 static void end_flight(gs_flight *f)
 {
-    if (GS_WITH_POSE && f->feet_on) gs_feet_flush(&f->feet);
+    if (GS_WITH_POSE && FEET_ON(f)) gs_feet_flush(&f->feet);
     if (f->state != GS_FS_AIRBORNE) return;
     bool waited = f->feet_wait_us != GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
