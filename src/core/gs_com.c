@@ -166,11 +166,12 @@ typedef struct {
     float w, x, y, e;
 } wsum;
 
-static NOINLINE void wsum_add(wsum *s, float w, vec2 p, float e)
+/* (x and y apart: a vec2 argument costs its callee a stack copy at -Os) */
+static NOINLINE void wsum_add(wsum *s, float w, float x, float y, float e)
 {
     s->w += w;
-    s->x += w * p.x;
-    s->y += w * p.y;
+    s->x += w * x;
+    s->y += w * y;
     s->e += w * e;
 }
 
@@ -203,7 +204,8 @@ static vec2 kp_diff(const frame *f, int a, int b)
 /* Keypoint base + s x (keypoint a - keypoint b). */
 static vec2 kp_extend(const frame *f, int base, int a, int b, float s)
 {
-    return v_add(f->p[base], v_scale(kp_diff(f, a, b), s));
+    vec2 d = kp_diff(f, a, b);
+    return (vec2){ f->p[base].x + d.x * s, f->p[base].y + d.y * s };
 }
 
 static float kp_dist(const frame *f, int a, int b)
@@ -270,10 +272,10 @@ static bool all_in(uint32_t set, uint32_t bits)
 
 /* One segment's COM enters with its full mass; w counts a rebuilt segment at half.
  * The observed ones of the keypoints in bits count for the confidence. */
-static NOINLINE void add_segment(frame *f, float mass, vec2 p, bool rebuilt, uint32_t bits)
+static NOINLINE void add_segment(frame *f, float mass, float x, float y, bool rebuilt, uint32_t bits)
 {
     f->used |= f->obs & bits;
-    wsum_add(&f->com, mass, p, rebuilt ? 0.5f : 1.0f);
+    wsum_add(&f->com, mass, x, y, rebuilt ? 0.5f : 1.0f);
 }
 
 static bool is_rebuilt(const frame *f, int a, int b)
@@ -459,7 +461,7 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
     } else if (has_prox) {
         com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
     }
-    add_segment(f, m, com, rebuilt, bits);
+    add_segment(f, m, com.x, com.y, rebuilt, bits);
 }
 
 static void add_limbs(frame *f, const seg_table *tb)
@@ -497,7 +499,7 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
         /* (a landmark not observed adds 0 to sums that start at +0, never -0: no change) */
-        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k], k_mark_frac[kind]);
+        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k].x, f->p[k].y, k_mark_frac[kind]);
     }
     const wsum *h = &g[0], *ft = &g[1];
     if (!(h->w > 0.0f) || !(ft->w > 0.0f)) {
@@ -733,12 +735,13 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     const uint32_t corners = BIT2(K_LSHO, K_RSHO) | BIT2(K_LHIP, K_RHIP);
     bool trunk_rebuilt = !all_in(f.obs, corners);
 
-    vec2 hc = { 0.0f, 0.0f };
+    vec2 hc; /* (head_centre always sets it) */
     uint32_t head_bits = head_centre(&f, &hc);
     if (head_bits) {
-        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, (head_bits & ~EARS) != 0u, head_bits);
+        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc.x, hc.y, (head_bits & ~EARS) != 0u, head_bits);
     }
-    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], v_lerp(s, p, tb->c[GS_SEG_TRUNK]), trunk_rebuilt, corners);
+    vec2 tc = v_lerp(s, p, tb->c[GS_SEG_TRUNK]);
+    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], tc.x, tc.y, trunk_rebuilt, corners);
     add_limbs(&f, tb);
     com_result(&f, table_total_pct(tb), out);
 }
