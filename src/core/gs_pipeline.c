@@ -83,14 +83,16 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
 {
     if (!p || !cfg || !storage || gs_layout_kp_count(layout) == 0) return GS_EINVAL;
     if (((uintptr_t)storage & 7u) != 0) return GS_EINVAL;
-    size_t need = gs_pipeline_storage_bytes(cfg);
+    if (!gs_cfg_is_baked(cfg)) return GS_EINVAL;  /* a baked build takes its own profile only */
+    const gs_core_config *in = GS_CFG_IN(cfg);  /* (so its ring's size is a constant there) */
+    size_t need = gs_pipeline_storage_bytes(in);
     if (need == 0 || storage_bytes < need) return GS_ENOMEM;
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
     p->layout = layout;
     p->on_event = on_event;
     p->ctx = ctx;
-    uint32_t cap = cfg->ring_capacity;
+    uint32_t cap = in->ring_capacity;
     gs_sample *samples = (gs_sample *)storage;
     uint32_t *scratch = (uint32_t *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
     gs_status st = gs_ring_init(&p->ring, samples, cap);
@@ -101,7 +103,7 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     gs_agg_init(&p->agg);
     p->sessions = GS_WITH_POSE && !is_point(layout);
     if (GS_WITH_POSE)
-        gs_session_init(&p->session, gs_time_us_of_cfg_s(cfg->session_absence_s), (gs_real)cfg->session_new_body_rel);
+        gs_session_init(&p->session, gs_time_us_of_cfg_s(in->session_absence_s), (gs_real)in->session_new_body_rel);
     st = gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, is_point(layout),
                         on_flight_event, p);
     if (st == GS_OK && !is_point(layout))
