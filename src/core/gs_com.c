@@ -122,7 +122,9 @@ static const seg_table *const k_tables[3] = {&k_deleva, &k_clauser, &k_dempster}
  * position is finite (c == 0 is missing even with min_conf 0). */
 static bool kp_usable(const gs_kp *q, float min_conf)
 {
-    return q->c > 0.0f && q->c <= FLT_MAX && q->c >= min_conf && gs_finite2_f(q->x_px, q->y_px);
+    /* (c >= a positive min_conf is c > 0: one test where min_conf is a constant) */
+    return q->c >= min_conf && (min_conf > 0.0f || q->c > 0.0f) && q->c <= FLT_MAX &&
+           gs_finite2_f(q->x_px, q->y_px);
 }
 
 static float conf01(float c)
@@ -164,11 +166,12 @@ typedef struct {
     float w, x, y, e;
 } wsum;
 
-static NOINLINE void wsum_add(wsum *s, float w, vec2 p, float e)
+/* (x and y apart: a vec2 argument costs its callee a stack copy at -Os) */
+static NOINLINE void wsum_add(wsum *s, float w, float x, float y, float e)
 {
     s->w += w;
-    s->x += w * p.x;
-    s->y += w * p.y;
+    s->x += w * x;
+    s->y += w * y;
     s->e += w * e;
 }
 
@@ -201,7 +204,8 @@ static vec2 kp_diff(const frame *f, int a, int b)
 /* Keypoint base + s x (keypoint a - keypoint b). */
 static vec2 kp_extend(const frame *f, int base, int a, int b, float s)
 {
-    return v_add(f->p[base], v_scale(kp_diff(f, a, b), s));
+    vec2 d = kp_diff(f, a, b);
+    return (vec2){ f->p[base].x + d.x * s, f->p[base].y + d.y * s };
 }
 
 static float kp_dist(const frame *f, int a, int b)
@@ -268,10 +272,10 @@ static bool all_in(uint32_t set, uint32_t bits)
 
 /* One segment's COM enters with its full mass; w counts a rebuilt segment at half.
  * The observed ones of the keypoints in bits count for the confidence. */
-static NOINLINE void add_segment(frame *f, float mass, vec2 p, bool rebuilt, uint32_t bits)
+static NOINLINE void add_segment(frame *f, float mass, float x, float y, bool rebuilt, uint32_t bits)
 {
     f->used |= f->obs & bits;
-    wsum_add(&f->com, mass, p, rebuilt ? 0.5f : 1.0f);
+    wsum_add(&f->com, mass, x, y, rebuilt ? 0.5f : 1.0f);
 }
 
 static bool is_rebuilt(const frame *f, int a, int b)
@@ -279,9 +283,10 @@ static bool is_rebuilt(const frame *f, int a, int b)
     return !all_in(f->obs, BIT2(a, b));
 }
 
+/* A keypoint not observed keeps c = 0 and position (0, 0): it adds nothing to a weighted sum. */
 static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
 {
-    f->obs = 0;
+    *f = (frame){ 0 };
 #ifndef __OPTIMIZE_SIZE__
     if (GS_WITH_COCO17 && !blaze) {
         /* the same as the loop below, without its per-keypoint layout choice */
@@ -293,34 +298,18 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
                 obs |= BIT(k);
                 f->c[k] = conf01(q->c);
                 f->p[k] = (vec2){ q->x_px, q->y_px };
-            } else {
-                f->c[k] = 0.0f;
-                f->p[k] = (vec2){ NAN, NAN };
             }
-        }
-        for (int k = 17; k < K_N; k++) {
-            f->c[k] = 0.0f;
-            f->p[k] = (vec2){ NAN, NAN };
         }
         f->obs = obs;
         f->have = obs;
         f->blaze = blaze;
-        f->used = 0;
-        f->com = (wsum){ 0.0f, 0.0f, 0.0f, 0.0f };
         return;
     }
 #endif
-    for (int k = 0; k < K_N; k++) {
-        f->c[k] = 0.0f;
-        f->p[k] = (vec2){ NAN, NAN };
-        int src = -1;
-        if (GS_WITH_COCO17 && !blaze) {
-            src = k < 17 ? k : -1;
-        } else if (GS_WITH_BLAZEPOSE33) {
-            src = k_blaze_index[k];
-        }
-        if (src >= 0 && kp_usable(&kp[src], min_conf)) {
-            const gs_kp *q = &kp[src];
+    bool coco = GS_WITH_COCO17 && !blaze;
+    for (int k = 0; k < (coco ? 17 : K_N); k++) { /* COCO-17's are the first 17 canonical ones */
+        const gs_kp *q = &kp[coco ? k : k_blaze_index[k]];
+        if (kp_usable(q, min_conf)) {
             f->obs |= BIT(k);
             f->c[k] = conf01(q->c);
             f->p[k] = (vec2){ q->x_px, q->y_px };
@@ -328,8 +317,6 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
     }
     f->have = f->obs;
     f->blaze = blaze;
-    f->used = 0;
-    f->com = (wsum){ 0.0f, 0.0f, 0.0f, 0.0f };
 }
 
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
@@ -386,24 +373,24 @@ static void mirror_joint(frame *f, int prox, vec2 axis, float across)
     f->have |= BIT(dist);
 }
 
+#define EARS BIT2(K_LEAR, K_REAR)
+
 /* Head centre from the ears, else a lone ear moved to the mid-line, else the
- * eyes, else the nose; *rebuilt when it is not the ears' own centre. Returns the
- * keypoints used, 0 when there is no head. */
-static uint32_t head_centre(const frame *f, vec2 *out, bool *rebuilt)
+ * eyes, else the nose. Returns the keypoints used, 0 when there is no head; any
+ * but the ears means a rebuilt centre (eyes and nose sit in front of it). */
+static uint32_t head_centre(const frame *f, vec2 *out)
 {
     const uint32_t eyes = BIT2(K_LEYE, K_REYE);
-    uint32_t ears = f->obs & BIT2(K_LEAR, K_REAR);
-    *rebuilt = true; /* eyes and nose sit in front of the head's centre */
+    uint32_t ears = f->obs & EARS;
     if (ears) {
         pair_centre(f, ears, K_LEAR, out);
-        if (ears != BIT2(K_LEAR, K_REAR) && all_in(f->obs, eyes)) {
+        if (ears != EARS && all_in(f->obs, eyes)) {
             /* shift the lone ear towards the mid-line by the eyes' half spread, scaled to ear breadth */
             int eye = ears == BIT(K_LEAR) ? K_LEYE : K_REYE;
             vec2 half = v_sub(v_mid(f->p[K_LEYE], f->p[K_REYE]), f->p[eye]);
             *out = v_add(*out, v_scale(half, EARS_OVER_EYES_HALF));
             return ears | eyes;
         }
-        *rebuilt = false;
         return ears;
     }
     if (pair_centre(f, f->obs, K_LEYE, out)) {
@@ -474,7 +461,7 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
     } else if (has_prox) {
         com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
     }
-    add_segment(f, m, com, rebuilt, bits);
+    add_segment(f, m, com.x, com.y, rebuilt, bits);
 }
 
 static void add_limbs(frame *f, const seg_table *tb)
@@ -511,10 +498,8 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 #endif
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
-        if (!(f->obs & BIT(k))) {
-            continue;
-        }
-        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k], k_mark_frac[kind]);
+        /* (a landmark not observed adds 0 to sums that start at +0, never -0: no change) */
+        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k].x, f->p[k].y, k_mark_frac[kind]);
     }
     const wsum *h = &g[0], *ft = &g[1];
     if (!(h->w > 0.0f) || !(ft->w > 0.0f)) {
@@ -695,7 +680,7 @@ static void com_result(const frame *f, float total, gs_com_out *out)
     if (gs_finite2_f(com.x, com.y)) {
         out->x_px = com.x;
         out->y_px = com.y;
-        out->w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
+        out->w = w > 1.0f ? 1.0f : w; /* never below 0: squares times confidences in (0, 1] */
     }
 }
 
@@ -723,7 +708,7 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
     rebuild_trunk_corner(&f, K_LSHO, K_LHIP, SHOULDER_OVER_HIP_WIDTH);
     rebuild_trunk_corner(&f, K_LHIP, K_LSHO, 1.0f / SHOULDER_OVER_HIP_WIDTH);
-    vec2 s = { NAN, NAN }, p = { NAN, NAN }, trunk = { 0.0f, 0.0f };
+    vec2 s, p, trunk = { 0.0f, 0.0f }; /* (s and p are read only when both were found) */
     bool have_trunk = pair_centre(&f, f.have, K_LSHO, &s) && pair_centre(&f, f.have, K_LHIP, &p);
     float trunk_len = 0.0f;
     if (have_trunk) {
@@ -750,13 +735,13 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     const uint32_t corners = BIT2(K_LSHO, K_RSHO) | BIT2(K_LHIP, K_RHIP);
     bool trunk_rebuilt = !all_in(f.obs, corners);
 
-    vec2 hc = { 0.0f, 0.0f };
-    bool head_rebuilt;
-    uint32_t head_bits = head_centre(&f, &hc, &head_rebuilt);
+    vec2 hc; /* (head_centre always sets it) */
+    uint32_t head_bits = head_centre(&f, &hc);
     if (head_bits) {
-        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc, head_rebuilt, head_bits);
+        add_segment(&f, tb->mass_pct[GS_SEG_HEAD], hc.x, hc.y, (head_bits & ~EARS) != 0u, head_bits);
     }
-    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], v_lerp(s, p, tb->c[GS_SEG_TRUNK]), trunk_rebuilt, corners);
+    vec2 tc = v_lerp(s, p, tb->c[GS_SEG_TRUNK]);
+    add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], tc.x, tc.y, trunk_rebuilt, corners);
     add_limbs(&f, tb);
     com_result(&f, table_total_pct(tb), out);
 }

@@ -15,7 +15,8 @@
  * its tip by about 1.5 cm, an ankle rides a plantarflexed foot about 9 cm above its rest */
 #define TOE_LIFT_REL   0.009f
 #define ANKLE_LIFT_REL 0.064f
-static const uint8_t k_feet_kp[][2] = {{0, 0}, {15, 16}, {31, 32}};  /* by gs_layout */
+#define COCO17_LEFT_ANKLE     15  /* the right one follows */
+#define BLAZEPOSE33_LEFT_TOE  31
 
 /* the pipeline's layout (one built in: gs_pipeline_init checks) is the point, or BlazePose-33;
  * constant where the build has one layout (gs_features.h) */
@@ -82,14 +83,16 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
 {
     if (!p || !cfg || !storage || gs_layout_kp_count(layout) == 0) return GS_EINVAL;
     if (((uintptr_t)storage & 7u) != 0) return GS_EINVAL;
-    size_t need = gs_pipeline_storage_bytes(cfg);
+    if (!gs_cfg_is_baked(cfg)) return GS_EINVAL;  /* a baked build takes its own profile only */
+    const gs_core_config *in = GS_CFG_IN(cfg);  /* (so its ring's size is a constant there) */
+    size_t need = gs_pipeline_storage_bytes(in);
     if (need == 0 || storage_bytes < need) return GS_ENOMEM;
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
     p->layout = layout;
     p->on_event = on_event;
     p->ctx = ctx;
-    uint32_t cap = cfg->ring_capacity;
+    uint32_t cap = in->ring_capacity;
     gs_sample *samples = (gs_sample *)storage;
     uint32_t *scratch = (uint32_t *)((unsigned char *)storage + ALIGN_UP(cap * sizeof(gs_sample), 8u));
     gs_status st = gs_ring_init(&p->ring, samples, cap);
@@ -100,7 +103,7 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     gs_agg_init(&p->agg);
     p->sessions = GS_WITH_POSE && !is_point(layout);
     if (GS_WITH_POSE)
-        gs_session_init(&p->session, gs_time_us_of_cfg_s(cfg->session_absence_s), (gs_real)cfg->session_new_body_rel);
+        gs_session_init(&p->session, gs_time_us_of_cfg_s(in->session_absence_s), (gs_real)in->session_new_body_rel);
     st = gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, is_point(layout),
                         on_flight_event, p);
     if (st == GS_OK && !is_point(layout))
@@ -148,7 +151,7 @@ static void emit_session(gs_pipeline *p, bool ended, const char *reason)
  * next one starts with its own aggregate and standing size. */
 static void track_session(gs_pipeline *p, const gs_sample_full *s)
 {
-    bool present = s->w >= 0.05f && gs_finite2_f(s->x_px, s->y_px);
+    bool present = s->w >= 0.05f;  /* (a sample's w is 0 where its position is not finite) */
     const char *why = NULL;
     uint32_t r = gs_session_frame(&p->session, s->t_us, present, gs_flight_stand_at(&p->flight, s->t_us), &why);
     if (r & GS_SESSION_ENDED) {
@@ -215,10 +218,17 @@ gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp,
     s.upright = com->upright;
     float feet[2 * GS_FEET_POINTS];  /* x then y of each point, NaN missing */
     for (int k = 0; k < GS_FEET_POINTS; k++) {
-        const gs_kp *f = &kp[k_feet_kp[p->layout][k]];
-        bool seen = !is_point(p->layout) && f->c >= GS_CFG_IN(&p->cfg)->min_conf && f->c > 0.0f;
-        feet[k] = seen ? f->x_px : NAN;
-        feet[GS_FEET_POINTS + k] = seen ? f->y_px : NAN;
+        float x = NAN, y = NAN;  /* a point has no feet */
+        if (!is_point(p->layout)) {
+            const gs_kp *f = &kp[(is_blaze(p->layout) ? BLAZEPOSE33_LEFT_TOE : COCO17_LEFT_ANKLE) + k];
+            float min_conf = GS_CFG_IN(&p->cfg)->min_conf;
+            if (f->c >= min_conf && (min_conf > 0.0f || f->c > 0.0f)) {  /* (as in gs_com.c) */
+                x = f->x_px;
+                y = f->y_px;
+            }
+        }
+        feet[k] = x;
+        feet[GS_FEET_POINTS + k] = y;
     }
     return push_sample(p, &s, feet);
 }
