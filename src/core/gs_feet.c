@@ -74,8 +74,8 @@ static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST -
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
 
-/* the point's height `back` frames before the newest */
-static NOINLINE float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
+/* the point's height `back` frames before the newest (inline: one load at a fixed slot, shorter than a call) */
+static inline float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
 
 /* The newest crossing of level L by the point within the history, rising (up) or falling,
  * interpolated between the two frames around it; GS_T_NONE when none. */
@@ -106,7 +106,7 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
  * of both: from the last frame surely above them the point falls on to L from its speed
  * between that frame and the one before, accelerating as a body falls, and reaches L no
  * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
-static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
+static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
 {
     float uk[GS_FEET_HIST];     /* finite heights, newest first (a missing or outlier frame is bridged) */
     uint32_t ak[GS_FEET_HIST];  /* their ages, us */
