@@ -1392,23 +1392,23 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     return solve_par(&f, out, p, GS_REAL_IS_FLOAT ? NULL : &base);
 }
 
-/* Index (into the window) of the k-th usable sample; count must cover it. */
-static uint32_t usable_index(const gs_win *wn, uint32_t k)
+/* The k-th usable sample (win_at, unpacked into *buf); count must cover it. */
+static const gs_fsamp *usable_at(const gs_win *wn, uint32_t k, gs_fsamp *buf)
 {
     uint32_t i;
     if (wn->m == wn->count) {
-        return k; /* the common case: no scan needed */
+        return win_at(wn, k, buf); /* the common case: no scan needed */
     }
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp sb;
-        if (win_at(wn, i, &sb)) {
+        const gs_fsamp *s = win_at(wn, i, buf);
+        if (s) {
             if (k == 0) {
-                return i;
+                return s;
             }
             k--;
         }
     }
-    return wn->count - 1;
+    return win_at(wn, wn->count - 1, buf);
 }
 
 /* The parabola through the ka-th, kb-th and kc-th usable samples (par_through). */
@@ -1418,9 +1418,8 @@ static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint3
     if (GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE) {
         return par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], p); /* every sample usable, cached */
     }
-    /* the window was checked to be held, and usable_index finds usable samples */
-    return par_through(win_at(wn, usable_index(wn, ka), &a), win_at(wn, usable_index(wn, kb), &b),
-                       win_at(wn, usable_index(wn, kc), &c), p);
+    /* the window was checked to be held, and usable_at finds usable samples */
+    return par_through(usable_at(wn, ka, &a), usable_at(wn, kb, &b), usable_at(wn, kc, &c), p);
 }
 
 /* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
