@@ -1498,15 +1498,18 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     return found;
 }
 
+/* The largest distance between two curves at the window's start, centre and end (tau -1/2, 0, 1/2), px. */
 static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
 {
-    static const gs_real taus[3] = {-GS_R(0.5), GS_R(0.0), GS_R(0.5)};
-    gs_real worst = GS_R(0.0);
+    gs_real worst = GS_R(0.0), diff[6];
     int k;
+    for (k = 0; k < 6; k++) {
+        diff[k] = a->c[k] - b->c[k]; /* the curves' difference, a parabola too */
+    }
     for (k = 0; k < 3; k++) {
-        gs_real t = taus[k];
-        gs_real dx = (a->c[0] - b->c[0]) + t * ((a->c[1] - b->c[1]) + t * (a->c[2] - b->c[2]));
-        gs_real dy = (a->c[3] - b->c[3]) + t * ((a->c[4] - b->c[4]) + t * (a->c[5] - b->c[5]));
+        gs_real t = GS_R(0.5) * (gs_real)(k - 1); /* the window's start, centre and end */
+        gs_real dx = diff[0] + t * (diff[1] + t * diff[2]);
+        gs_real dy = diff[3] + t * (diff[4] + t * diff[5]);
         gs_real d = sqrt(dx * dx + dy * dy);
         if (!(d <= worst)) {
             worst = d;
