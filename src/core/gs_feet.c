@@ -20,7 +20,7 @@
 #define RISE_REST_K 3       /* a floor higher than the last one must be rested on this many times longer
                              * (stepping onto a box takes long; a foot at its apex in the air is still briefly) */
 /* the touch by recrossing serves ankles (COCO-17) only: a build without that layout has none */
-#define RECROSS GS_WITH_COCO17
+#define RECROSS GS_WITH_COCO17  /* (touch_unsure is 2 after a recrossing only) */
 #define NOISE_K     3.0f   /* margins at least this many of the point's own jitter */
 #define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
 #define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
@@ -74,8 +74,8 @@ static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST -
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
 
-/* the point's height `back` frames before the newest */
-static NOINLINE float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
+/* the point's height `back` frames before the newest (inline: one load at a fixed slot, shorter than a call) */
+static inline float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
 
 /* The newest crossing of level L by the point within the history, rising (up) or falling,
  * interpolated between the two frames around it; GS_T_NONE when none. */
@@ -106,7 +106,7 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
  * of both: from the last frame surely above them the point falls on to L from its speed
  * between that frame and the one before, accelerating as a body falls, and reaches L no
  * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
-static NOINLINE int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
+static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
 {
     float uk[GS_FEET_HIST];     /* finite heights, newest first (a missing or outlier frame is bridged) */
     uint32_t ak[GS_FEET_HIST];  /* their ages, us */
@@ -196,12 +196,12 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* a floor holds the point: the frame after a stop stays at its level; after a recrossing
      * (ankles) the heel comes down onto that level, not past it */
     if (f->touch_unsure) {
-        if (u < f->touch[0].level_px - (float)f->touch_unsure * margin) {
+        if (u < f->touch[0].level_px - (RECROSS ? (float)f->touch_unsure * margin : margin)) {
             memmove(f->touch, f->touch + 1, (GS_FEET_LOG - 1) * sizeof f->touch[0]);  /* it fell on */
             f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
-            f->lifted = f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
+            f->lifted = RECROSS && f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
             f->touch_unsure = 0;
-        } else if (f->touch_unsure == 1 || !(v2 < 0.0f)) {
+        } else if (!RECROSS || f->touch_unsure == 1 || !(v2 < 0.0f)) {
             f->touch_unsure = 0;
         }
     }
@@ -222,7 +222,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* a touch by the stop: falling fast, then (nearly) stopped by the floor (for ankles only
      * well below the level they left: a lower floor) */
     /* the floor slows the point at once (a heel comes down at well under a stature per second); in the air it falls on */
-    f->falling = v2 < -FALL_REL * size_px;
+    if (RECROSS) f->falling = v2 < -FALL_REL * size_px;  /* (read for recrossings only) */
     float vf = speed(ft, f, 2);  /* (the impact may fall inside the last falling interval) */
     if (!(vf < v1)) vf = v1;
     if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
@@ -370,7 +370,7 @@ int64_t gs_feet_landing(const gs_feet *ft, int64_t from_us, int64_t to_us, float
         for (int k = 0; k < GS_FEET_LOG; k++) {
             const gs_feet_event *e = &ft->pt[p].touch[k];
             /* a recrossing the point is still falling fast past is not a landing (yet) */
-            if (k == 0 && ft->pt[p].touch_unsure == 2 && ft->pt[p].falling) continue;
+            if (RECROSS && k == 0 && ft->pt[p].touch_unsure == 2 && ft->pt[p].falling) continue;
             /* (GS_T_NONE, the lowest int64, is never after from_us) */
             if (e->t_us > from_us && e->t_us <= to_us && (!best || e->t_us < best->t_us))
                 best = e;
@@ -402,7 +402,7 @@ bool gs_feet_airborne(const gs_feet *ft)
 {
     /* (an ankle's recrossing is a landing only once its heel is down or it stops falling) */
     for (int p = 0; p < GS_FEET_POINTS; p++)
-        if (ft->pt[p].lifted || ft->pt[p].touch_unsure == 2) return true;
+        if (ft->pt[p].lifted || (RECROSS && ft->pt[p].touch_unsure == 2)) return true;
     return false;
 }
 

@@ -7,6 +7,7 @@
 #include <tgmath.h>  /* sqrt, fabs, atan2 follow gs_real */
 
 #include "gs_finite.h"
+#include "gs_inline.h"
 #include "gs_select.h"
 
 
@@ -99,13 +100,6 @@ void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
     fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, tscale_us > 0 ? tscale_us : GS_US_PER_S);
 }
 
-/* Index of R(i, j), j >= i, in the packed row-major upper triangle. */
-static int rix(int i, int j)
-{
-    static const int base[3] = {0, 3, 5};
-    return base[i] + (j - i);
-}
-
 /* The centred, scaled time of t_us: the exact integer span over the scale, both in microseconds. */
 static gs_real fit_tau(int64_t t_us, int64_t t0_us, gs_real tscale_us)
 {
@@ -123,7 +117,7 @@ static void rot(gs_real *e, gs_real *v, gs_real c, gs_real s)
 /* Rotate the weighted row (1, tau, tau^2 | x, y) into [R | zx zy]; w > 0 and all values finite. */
 static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real w)
 {
-    gs_real v[5], sw;
+    gs_real v[5], sw, *rk = f->r; /* row k of R, packed: R(k, j) at rk[j - k] */
     int k, j;
     sw = sqrt((gs_real)w);
     v[0] = sw;
@@ -134,8 +128,7 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
 #if GS_FIT_FAST
 #pragma GCC unroll 3 /* hosts: every index constant, no branch per entry (the firmware keeps the loops) */
 #endif
-    for (k = 0; k < 3; k++) {
-        gs_real *rk = &f->r[rix(k, k)]; /* row k of R, packed: R(k, j) at rk[j - k] */
+    for (k = 0; k < 3; rk += 3 - k, k++) {
         gs_real a = rk[0];
         gs_real b = v[k];
         gs_real rho, c, sn;
@@ -167,9 +160,12 @@ void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
 }
 
-static void nan_result(gs_fit_result *out)
+/* No curve yet: the result's centre and count, every value NaN (one copy for both callers) */
+static NOINLINE void empty_result(gs_fit_result *out, int64_t t0_us, uint32_t n)
 {
     const gs_real nan = (gs_real)NAN;
+    out->t0_us = t0_us;
+    out->n = n;
     out->x0_px = out->vx_px_s = out->ax_px_s2 = nan;
     out->y0_px = out->vy_px_s = out->ay_px_s2 = nan;
     out->a_px_s2 = out->a_se_px_s2 = out->g_dir_deg = out->rms_px = nan;
@@ -194,13 +190,12 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
 {
     gs_par par;
     gs_real *cx = &par.c[0], *cy = &par.c[3], col[3], ts, ts2, ssr;
+    const gs_real *rk = f->r; /* row k of R: its diagonal first */
     int k;
     if (!f || !out) {
         return GS_EINVAL;
     }
-    out->t0_us = f->t0_us;
-    out->n = f->n;
-    nan_result(out);
+    empty_result(out, f->t0_us, f->n);
     if (f->n < 3) {
         return GS_EINVAL;
     }
@@ -208,8 +203,8 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     col[0] = fabs(f->r[0]);
     col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
-    for (k = 0; k < 3; k++) {
-        gs_real d = fabs(f->r[rix(k, k)]);
+    for (k = 0; k < 3; rk += 3 - k, k++) {
+        gs_real d = fabs(*rk);
         if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !gs_finite_r(d)) {
             return GS_EINVAL;
         }
@@ -256,6 +251,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
 static gs_status solve_par_only(const gs_fit *f, gs_par *p, const gs_par *base)
 {
     gs_real col[3];
+    const gs_real *rk = f->r;
     int k;
     if (f->n < 3) {
         return GS_EINVAL;
@@ -263,8 +259,8 @@ static gs_status solve_par_only(const gs_fit *f, gs_par *p, const gs_par *base)
     col[0] = fabs(f->r[0]);
     col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
-    for (k = 0; k < 3; k++) {
-        gs_real d = fabs(f->r[rix(k, k)]);
+    for (k = 0; k < 3; rk += 3 - k, k++) {
+        gs_real d = fabs(*rk);
         if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
             return GS_EINVAL;
         }
@@ -1339,9 +1335,11 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
 #if GS_FIT_FAST
     base = model && !GS_REAL_IS_FLOAT ? *model : (gs_par){{0}};
 #else
-    memset(&base, 0, sizeof base);
-    if (model && !GS_REAL_IS_FLOAT) {
-        base = *model;
+    if (!GS_REAL_IS_FLOAT) { /* (float fits rotate the rows: no sums, no base) */
+        memset(&base, 0, sizeof base);
+        if (model) {
+            base = *model;
+        }
     }
 #endif
     fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
@@ -1359,7 +1357,9 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
         return solve_par(&f, out, p, &base);
     }
 #endif
-    memset(&a, 0, sizeof a);
+    if (!GS_REAL_IS_FLOAT) {
+        memset(&a, 0, sizeof a);
+    }
     for (i = 0; i < wn->count; i++) {
         gs_fsamp b;
         const gs_fsamp *s = win_at(wn, i, &b);
@@ -1392,23 +1392,23 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
     return solve_par(&f, out, p, GS_REAL_IS_FLOAT ? NULL : &base);
 }
 
-/* Index (into the window) of the k-th usable sample; count must cover it. */
-static uint32_t usable_index(const gs_win *wn, uint32_t k)
+/* The k-th usable sample (win_at, unpacked into *buf); count must cover it. */
+static const gs_fsamp *usable_at(const gs_win *wn, uint32_t k, gs_fsamp *buf)
 {
     uint32_t i;
     if (wn->m == wn->count) {
-        return k; /* the common case: no scan needed */
+        return win_at(wn, k, buf); /* the common case: no scan needed */
     }
     for (i = 0; i < wn->count; i++) {
-        gs_fsamp sb;
-        if (win_at(wn, i, &sb)) {
+        const gs_fsamp *s = win_at(wn, i, buf);
+        if (s) {
             if (k == 0) {
-                return i;
+                return s;
             }
             k--;
         }
     }
-    return wn->count - 1;
+    return win_at(wn, wn->count - 1, buf);
 }
 
 /* The parabola through the ka-th, kb-th and kc-th usable samples (par_through). */
@@ -1418,9 +1418,8 @@ static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint3
     if (GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE) {
         return par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], p); /* every sample usable, cached */
     }
-    /* the window was checked to be held, and usable_index finds usable samples */
-    return par_through(win_at(wn, usable_index(wn, ka), &a), win_at(wn, usable_index(wn, kb), &b),
-                       win_at(wn, usable_index(wn, kc), &c), p);
+    /* the window was checked to be held, and usable_at finds usable samples */
+    return par_through(usable_at(wn, ka, &a), usable_at(wn, kb, &b), usable_at(wn, kc, &c), p);
 }
 
 /* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
@@ -1499,15 +1498,18 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     return found;
 }
 
+/* The largest distance between two curves at the window's start, centre and end (tau -1/2, 0, 1/2), px. */
 static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
 {
-    static const gs_real taus[3] = {-GS_R(0.5), GS_R(0.0), GS_R(0.5)};
-    gs_real worst = GS_R(0.0);
+    gs_real worst = GS_R(0.0), diff[6];
     int k;
+    for (k = 0; k < 6; k++) {
+        diff[k] = a->c[k] - b->c[k]; /* the curves' difference, a parabola too */
+    }
     for (k = 0; k < 3; k++) {
-        gs_real t = taus[k];
-        gs_real dx = (a->c[0] - b->c[0]) + t * ((a->c[1] - b->c[1]) + t * (a->c[2] - b->c[2]));
-        gs_real dy = (a->c[3] - b->c[3]) + t * ((a->c[4] - b->c[4]) + t * (a->c[5] - b->c[5]));
+        gs_real t = GS_R(0.5) * (gs_real)(k - 1); /* the window's start, centre and end */
+        gs_real dx = diff[0] + t * (diff[1] + t * diff[2]);
+        gs_real dy = diff[3] + t * (diff[4] + t * diff[5]);
         gs_real d = sqrt(dx * dx + dy * dy);
         if (!(d <= worst)) {
             worst = d;
@@ -1800,9 +1802,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (!out) {
         return GS_EINVAL;
     }
-    out->t0_us = GS_T_NONE;
-    out->n = 0;
-    nan_result(out);
+    empty_result(out, GS_T_NONE, 0);
     if (!ring || !keep || count == 0) {
         return GS_EINVAL;
     }
