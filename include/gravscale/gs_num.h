@@ -29,6 +29,10 @@ bool gs_num_parse_int(const char *s, size_t len, long *out);
  * or cap is too small (buf then holds ""). */
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals);
 
+/* gs_num_fmt_fixed of the float v's exact value, from its bits: where doubles are
+ * emulated (a Cortex-M4F) no widening to double. */
+size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals);
+
 /* Format t_us microseconds as seconds with exactly `decimals` (0..9) digits after
  * the point, rounded half away from zero (exact: from the integer's decimal digits),
  * "-0.000" printed as "0.000". Writes a NUL. Returns chars written (without the NUL),

@@ -89,38 +89,6 @@ static void w_u32(gs_w *w, uint32_t v, size_t width)
     if (!width || sizeof t - n <= width) w_raw(w, t + n, sizeof t - n);
 }
 
-/* v with `decimals` decimals. width 0 (JSON): null when v is not finite or beyond
- * 1e15. width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the
- * text is wider, nothing when v is unknown or cannot fit. */
-static void w_fixed(gs_w *w, double v, int decimals, size_t width)
-{
-    char t[40];
-    for (int d = decimals; d >= 0; d--) {
-        size_t n = gs_num_fmt_fixed(t, sizeof t, v, d);
-        if (n && (!width || n <= width)) {
-            w_raw(w, t, n);
-            return;
-        }
-        if (!width) break;
-    }
-    if (!width) w_lit(w, "null");
-}
-
-/* t_us as seconds with `decimals` decimals, otherwise as w_fixed (GS_T_NONE: unknown) */
-static void w_time(gs_w *w, int64_t t_us, int decimals, size_t width)
-{
-    char t[40];
-    for (int d = decimals; d >= 0; d--) {
-        size_t n = gs_num_fmt_us(t, sizeof t, t_us, d);
-        if (n && (!width || n <= width)) {
-            w_raw(w, t, n);
-            return;
-        }
-        if (!width) break;
-    }
-    if (!width) w_lit(w, "null");
-}
-
 /* the gs_real at p as a double: exact (where gs_real is float, from its bits: no libgcc conversion) */
 static double real_at(const void *p)
 {
@@ -161,6 +129,40 @@ _Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field
 
 static const void *field_at(const void *base, const field *f) { return (const char *)base + f->off; }
 
+/* the number of kind V_FIXED (gs_real), V_FLOAT (float) or V_TIME (int64_t microseconds,
+ * as seconds) at p with `decimals` decimals: a float from its bits, no double emulated */
+static size_t fmt_number(char *t, size_t cap, int kind, const void *p, int decimals)
+{
+    if (kind == V_TIME) {
+        int64_t us;
+        memcpy(&us, p, sizeof us);
+        return gs_num_fmt_us(t, cap, us, decimals);
+    }
+    if (kind == V_FLOAT || GS_REAL_IS_FLOAT) {
+        float x;
+        memcpy(&x, p, sizeof x);
+        return gs_num_fmt_fixed_f(t, cap, x, decimals);
+    }
+    return gs_num_fmt_fixed(t, cap, real_at(p), decimals);
+}
+
+/* That number. width 0 (JSON): null when it is unknown, not finite or beyond 1e15.
+ * width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the text is
+ * wider, nothing when it is unknown or cannot fit. */
+static void w_number(gs_w *w, int kind, const void *p, int decimals, size_t width)
+{
+    char t[40];
+    for (int d = decimals; d >= 0; d--) {
+        size_t n = fmt_number(t, sizeof t, kind, p, d);
+        if (n && (!width || n <= width)) {
+            w_raw(w, t, n);
+            return;
+        }
+        if (!width) break;
+    }
+    if (!width) w_lit(w, "null");
+}
+
 /* the kinds both formats use; false for the others */
 static bool w_common(gs_w *w, const void *base, const field *f)
 {
@@ -169,12 +171,8 @@ static bool w_common(gs_w *w, const void *base, const field *f)
         uint32_t v;
         memcpy(&v, p, sizeof v);
         w_u32(w, v, f->b);
-    } else if (f->kind == V_FIXED) {
-        w_fixed(w, real_at(p), f->a, f->b);
-    } else if (f->kind == V_TIME) {
-        int64_t t;
-        memcpy(&t, p, sizeof t);
-        w_time(w, t, f->a, f->b);
+    } else if (f->kind == V_FIXED || f->kind == V_TIME) {
+        w_number(w, f->kind, p, f->a, f->b);
     } else {
         return false;
     }
@@ -376,13 +374,12 @@ static void w_warnings(gs_w *w, uint32_t bits)
 /* [lo,hi], or null: an interval with an unknown end is no interval */
 static void w_ci95(gs_w *w, const void *mid_lo_hi)
 {
-    double v[3];
-    for (int i = 0; i < 3; i++) v[i] = real_at((const gs_real *)mid_lo_hi + i);
-    if (gs_dfinite(v[1]) && gs_dfinite(v[2]) && gs_dfinite(v[0])) {
+    const gs_real *v = mid_lo_hi;
+    if (gs_dfinite(real_at(v + 1)) && gs_dfinite(real_at(v + 2)) && gs_dfinite(real_at(v))) {
         w_raw(w, "[", 1);
-        w_fixed(w, v[1], 4, 0);
+        w_number(w, V_FIXED, v + 1, 4, 0);
         w_raw(w, ",", 1);
-        w_fixed(w, v[2], 4, 0);
+        w_number(w, V_FIXED, v + 2, 4, 0);
         w_raw(w, "]", 1);
     } else {
         w_lit(w, "null");
@@ -396,7 +393,6 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
     if (w_common(w, base, f)) return;
     const void *p = field_at(base, f);
     double d;
-    float x;
     const char *s;
     bool b;
     switch (f->kind) {
@@ -408,8 +404,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         else w_lit(w, "null");
         break;
     case V_FLOAT:
-        memcpy(&x, p, sizeof x);
-        w_fixed(w, gs_dwiden(x), f->a, 0);
+        w_number(w, V_FLOAT, p, f->a, 0);
         break;
     case V_STR:
         memcpy(&s, p, sizeof s);

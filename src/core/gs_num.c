@@ -457,16 +457,9 @@ static void dec_digits(gs_big *n, int p, gs_dec *d)
     while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
 }
 
-static void dec_expand(uint64_t abs_bits, gs_dec *d)
+/* the decimal digits of a = mant * 2^e2 (mant > 0) into d */
+static void dec_expand(uint64_t mant, int e2, gs_dec *d)
 {
-    /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
-    int be = (int)(abs_bits >> 52);
-    uint64_t mant = abs_bits & ((1ull << 52) - 1u);
-    int e2 = -1074; /* subnormal */
-    if (be) {
-        mant |= 1ull << 52;
-        e2 = be - 1075;
-    }
     while (!(mant & 1u)) {
         mant >>= 1;
         e2++;
@@ -480,6 +473,16 @@ static void dec_expand(uint64_t abs_bits, gs_dec *d)
         (void)big_mul_add(&n, e2 < 0 ? k_pow5_u32[step] : 1u << step, 0);
     }
     dec_digits(&n, e2 < 0 ? -e2 : 0, d);
+}
+
+/* the decimal digits of the double of magnitude bits abs_bits (finite, not 0) */
+static void dec_of_dbits(uint64_t abs_bits, gs_dec *d)
+{
+    /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
+    int be = (int)(abs_bits >> 52);
+    uint64_t mant = abs_bits & ((1ull << 52) - 1u);
+    if (be) mant |= 1ull << 52;
+    dec_expand(mant, be ? be - 1075 : -1074, d);
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -558,8 +561,28 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
     if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     gs_dec d;
-    if (mag) dec_expand(mag, &d);
+    if (mag) dec_of_dbits(mag, &d);
     return fmt_dec(buf, cap, mag ? &d : NULL, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+}
+
+size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    uint32_t mag = bits & 0x7FFFFFFFu;
+    float below_1e15 = 1e15f; /* the float nearest 1e15 is the largest below it */
+    uint32_t limit;
+    memcpy(&limit, &below_1e15, sizeof limit);
+    /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
+    if (mag > limit || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
+    gs_dec d;
+    if (mag) {
+        /* a = mant * 2^e2 from the IEEE bits, as dec_of_dbits */
+        uint32_t be = mag >> 23, mant = mag & 0x7FFFFFu;
+        if (be) mant |= 0x800000u;
+        dec_expand(mant, be ? (int)be - 150 : -149, &d);
+    }
+    return fmt_dec(buf, cap, mag ? &d : NULL, (bits >> 31) != 0u, decimals);
 }
 
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
@@ -582,7 +605,7 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     if (mag >= GS_DBITS_INF || sig < 1 || sig > 15) return put_out(buf, cap, "", FMT_FAIL);
     if (!mag) return put_out(buf, cap, "0", 1u);
     gs_dec d;
-    dec_expand(mag, &d);
+    dec_of_dbits(mag, &d);
     char dig[DEC_KEEP];
     int k = d.nd - d.p - 1; /* decimal exponent of the first digit */
     k += dec_round(&d, sig, dig); /* a carry: 1 and zeros, cut to sig digits below */
