@@ -445,34 +445,25 @@ typedef struct {
     int p;
 } gs_dec;
 
-/* the decimal digits of n > 0 (consumed) into d, worth n * 10^-p */
-static void dec_digits(gs_big *n, int p, gs_dec *d)
+/* the decimal digits of a = mant * 2^e2 * 10^-p10 (mant > 0) into d */
+static void dec_expand(uint64_t mant, int e2, int p10, gs_dec *d)
 {
-    d->p = p;
-    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower) */
-    d->nd = 0;
-    while (n->n)
-        for (uint32_t r = big_divmod_small(n, 10000u), j = 0; j < 4; j++, r /= 10u)
-            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
-    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
-}
-
-/* the decimal digits of a = mant * 2^e2 (mant > 0) into d */
-static void dec_expand(uint64_t mant, int e2, gs_dec *d)
-{
-    while (!(mant & 1u)) {
-        mant >>= 1;
-        e2++;
-    }
     gs_big n;
     big_set(&n, mant);
-    /* a = mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
+    /* mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
     uint32_t k = (uint32_t)(e2 < 0 ? -e2 : e2);
     for (; k; k -= k < 13u ? k : 13u) {
         uint32_t step = k < 13u ? k : 13u;
         (void)big_mul_add(&n, e2 < 0 ? k_pow5_u32[step] : 1u << step, 0);
     }
-    dec_digits(&n, e2 < 0 ? -e2 : 0, d);
+    d->p = p10 + (e2 < 0 ? -e2 : 0);
+    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower); the
+     * divisions are 32-bit: no 64-bit division routine linked */
+    d->nd = 0;
+    while (n.n)
+        for (uint32_t r = big_divmod_small(&n, 10000u), j = 0; j < 4; j++, r /= 10u)
+            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
+    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
 }
 
 /* the decimal digits of the double of magnitude bits abs_bits (finite, not 0) */
@@ -482,7 +473,7 @@ static void dec_of_dbits(uint64_t abs_bits, gs_dec *d)
     int be = (int)(abs_bits >> 52);
     uint64_t mant = abs_bits & ((1ull << 52) - 1u);
     if (be) mant |= 1ull << 52;
-    dec_expand(mant, be ? be - 1075 : -1074, d);
+    dec_expand(mant, be ? be - 1075 : -1074, 0, d);
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -580,7 +571,7 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
         /* a = mant * 2^e2 from the IEEE bits, as dec_of_dbits */
         uint32_t be = mag >> 23, mant = mag & 0x7FFFFFu;
         if (be) mant |= 0x800000u;
-        dec_expand(mant, be ? (int)be - 150 : -149, &d);
+        dec_expand(mant, be ? (int)be - 150 : -149, 0, &d);
     }
     return fmt_dec(buf, cap, mag ? &d : NULL, (bits >> 31) != 0u, decimals);
 }
@@ -590,12 +581,7 @@ size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
     if (t_us == INT64_MIN || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     uint64_t mag = t_us < 0 ? (uint64_t)-t_us : (uint64_t)t_us;
     gs_dec d;
-    if (mag) {
-        /* the digits by 32-bit divisions: no 64-bit division routine linked */
-        gs_big n;
-        big_set(&n, mag);
-        dec_digits(&n, 6, &d);
-    }
+    if (mag) dec_expand(mag, 0, 6, &d);
     return fmt_dec(buf, cap, mag ? &d : NULL, t_us < 0, decimals);
 }
 
