@@ -146,37 +146,28 @@ static size_t fmt_number(char *t, size_t cap, int kind, const void *p, int decim
     return gs_num_fmt_fixed(t, cap, real_at(p), decimals);
 }
 
-/* That number. width 0 (JSON): null when it is unknown, not finite or beyond 1e15.
+/* That number; false (nothing written) when it is unknown, not finite or beyond 1e15.
  * width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the text is
- * wider, nothing when it is unknown or cannot fit. */
-static void w_number(gs_w *w, int kind, const void *p, int decimals, size_t width)
+ * wider, false when it cannot fit. */
+static bool w_number(gs_w *w, int kind, const void *p, int decimals, size_t width)
 {
     char t[40];
     for (int d = decimals; d >= 0; d--) {
         size_t n = fmt_number(t, sizeof t, kind, p, d);
         if (n && (!width || n <= width)) {
             w_raw(w, t, n);
-            return;
+            return true;
         }
         if (!width) break;
     }
-    if (!width) w_lit(w, "null");
+    return false;
 }
 
-/* the kinds both formats use; false for the others */
-static bool w_common(gs_w *w, const void *base, const field *f)
+static uint32_t u32_at(const void *p)
 {
-    const void *p = field_at(base, f);
-    if (f->kind == V_U32) {
-        uint32_t v;
-        memcpy(&v, p, sizeof v);
-        w_u32(w, v, f->b);
-    } else if (f->kind == V_FIXED || f->kind == V_TIME) {
-        w_number(w, f->kind, p, f->a, f->b);
-    } else {
-        return false;
-    }
-    return true;
+    uint32_t v;
+    memcpy(&v, p, sizeof v);
+    return v;
 }
 
 /* ------------------------------------------------------------------ NMEA */
@@ -199,11 +190,13 @@ static const char k_hex_upper[] = "0123456789ABCDEF";
 /* after its comma */
 static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
 {
-    if (w_common(w, base, f)) return;
     const void *p = field_at(base, f);
     char c[2];
     size_t n = 0;
     switch (f->kind) {
+    case V_U32: w_u32(w, u32_at(p), f->b); return;
+    case V_FIXED:
+    case V_TIME: (void)w_number(w, f->kind, p, f->a, f->b); return;
     case V_FLAG: {
         bool b;
         memcpy(&b, p, sizeof b);
@@ -224,8 +217,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
         break;
     }
     case V_HEX8: { /* the GS_WARN_* bits in hex */
-        uint32_t b;
-        memcpy(&b, p, sizeof b);
+        uint32_t b = u32_at(p);
         c[n++] = k_hex_upper[(b >> 4) & 15u];
         c[n++] = k_hex_upper[b & 15u];
         break;
@@ -371,15 +363,21 @@ static void w_warnings(gs_w *w, uint32_t bits)
     w_raw(w, "]", 1);
 }
 
+/* a number, or null */
+static void w_json_number(gs_w *w, int kind, const void *p, int decimals)
+{
+    if (!w_number(w, kind, p, decimals, 0)) w_lit(w, "null");
+}
+
 /* [lo,hi], or null: an interval with an unknown end is no interval */
 static void w_ci95(gs_w *w, const void *mid_lo_hi)
 {
     const gs_real *v = mid_lo_hi;
     if (gs_dfinite(real_at(v + 1)) && gs_dfinite(real_at(v + 2)) && gs_dfinite(real_at(v))) {
         w_raw(w, "[", 1);
-        w_number(w, V_FIXED, v + 1, 4, 0);
+        w_json_number(w, V_FIXED, v + 1, 4);
         w_raw(w, ",", 1);
-        w_number(w, V_FIXED, v + 2, 4, 0);
+        w_json_number(w, V_FIXED, v + 2, 4);
         w_raw(w, "]", 1);
     } else {
         w_lit(w, "null");
@@ -390,7 +388,6 @@ static const char *const k_json_bool[][2] = {{"true", "false"}, {"\"end\"", "\"s
 
 static void w_json_value(gs_w *w, const void *base, const field *f)
 {
-    if (w_common(w, base, f)) return;
     const void *p = field_at(base, f);
     double d;
     const char *s;
@@ -403,8 +400,11 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         if (n) w_raw(w, t, n);
         else w_lit(w, "null");
         break;
+    case V_U32: w_u32(w, u32_at(p), 0); break;
+    case V_FIXED:
+    case V_TIME:
     case V_FLOAT:
-        w_number(w, V_FLOAT, p, f->a, 0);
+        w_json_number(w, f->kind, p, f->a);
         break;
     case V_STR:
         memcpy(&s, p, sizeof s);
@@ -420,9 +420,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         break;
     }
     case V_WARNINGS: {
-        uint32_t bits;
-        memcpy(&bits, p, sizeof bits);
-        w_warnings(w, bits);
+        w_warnings(w, u32_at(p));
         break;
     }
     default: w_ci95(w, p); break;
