@@ -466,14 +466,14 @@ static void dec_expand(uint64_t mant, int e2, int p10, gs_dec *d)
     while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
 }
 
-/* the decimal digits of the double of magnitude bits abs_bits (finite, not 0) */
-static void dec_of_dbits(uint64_t abs_bits, gs_dec *d)
+/* the magnitude bits of a double (finite) as mant * 2^e2 (no frexp/ldexp, no double arithmetic) */
+static uint64_t dbits_mant(uint64_t abs_bits, int *e2)
 {
-    /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
     int be = (int)(abs_bits >> 52);
     uint64_t mant = abs_bits & ((1ull << 52) - 1u);
     if (be) mant |= 1ull << 52;
-    dec_expand(mant, be ? be - 1075 : -1074, 0, d);
+    *e2 = be ? be - 1075 : -1074;
+    return mant;
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -531,15 +531,18 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
     return n;
 }
 
-/* |value| = D * 10^-p from d (NULL: 0) with `decimals` decimals, rounded half away
- * from zero, a minus sign when neg and the rounded value is not 0 */
-static size_t fmt_dec(char *buf, size_t cap, const gs_dec *d, bool neg, int decimals)
+/* |value| = mant * 2^e2 * 10^-p10 with `decimals` decimals, rounded half away from
+ * zero, a minus sign when neg and the rounded value is not 0; "" unless 0 <= decimals <= 9 */
+static size_t fmt_dec(char *buf, size_t cap, uint64_t mant, int e2, int p10, bool neg, int decimals)
 {
+    if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
     int nr = 0;
-    if (d) {
-        int count = d->nd - d->p + decimals; /* digits at or above 10^-decimals */
-        if (count >= 0) nr = count + dec_round(d, count, dig);
+    if (mant) {
+        gs_dec d;
+        dec_expand(mant, e2, p10, &d);
+        int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
+        if (count >= 0) nr = count + dec_round(&d, count, dig);
     }
     char t[48];
     size_t n = put_digits(t, nr && neg, dig, nr, nr - decimals, decimals);
@@ -550,10 +553,10 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
-    gs_dec d;
-    if (mag) dec_of_dbits(mag, &d);
-    return fmt_dec(buf, cap, mag ? &d : NULL, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+    if (mag >= gs_dbits(1e15)) return put_out(buf, cap, "", FMT_FAIL);
+    int e2;
+    uint64_t mant = dbits_mant(mag, &e2);
+    return fmt_dec(buf, cap, mant, e2, 0, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
 }
 
 size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
@@ -565,24 +568,18 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
     uint32_t limit;
     memcpy(&limit, &below_1e15, sizeof limit);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag > limit || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
-    gs_dec d;
-    if (mag) {
-        /* a = mant * 2^e2 from the IEEE bits, as dec_of_dbits */
-        uint32_t be = mag >> 23, mant = mag & 0x7FFFFFu;
-        if (be) mant |= 0x800000u;
-        dec_expand(mant, be ? (int)be - 150 : -149, 0, &d);
-    }
-    return fmt_dec(buf, cap, mag ? &d : NULL, (bits >> 31) != 0u, decimals);
+    if (mag > limit) return put_out(buf, cap, "", FMT_FAIL);
+    /* |v| = mant * 2^e2 from the IEEE bits, as dbits_mant */
+    uint32_t be = mag >> 23, mant = mag & 0x7FFFFFu;
+    if (be) mant |= 0x800000u;
+    return fmt_dec(buf, cap, mant, be ? (int)be - 150 : -149, 0, (bits >> 31) != 0u, decimals);
 }
 
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
 {
-    if (t_us == INT64_MIN || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
+    if (t_us == INT64_MIN) return put_out(buf, cap, "", FMT_FAIL);
     uint64_t mag = t_us < 0 ? (uint64_t)-t_us : (uint64_t)t_us;
-    gs_dec d;
-    if (mag) dec_expand(mag, 0, 6, &d);
-    return fmt_dec(buf, cap, mag ? &d : NULL, t_us < 0, decimals);
+    return fmt_dec(buf, cap, mag, 0, 6, t_us < 0, decimals);
 }
 
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
@@ -591,7 +588,9 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     if (mag >= GS_DBITS_INF || sig < 1 || sig > 15) return put_out(buf, cap, "", FMT_FAIL);
     if (!mag) return put_out(buf, cap, "0", 1u);
     gs_dec d;
-    dec_of_dbits(mag, &d);
+    int e2;
+    uint64_t mant = dbits_mant(mag, &e2);
+    dec_expand(mant, e2, 0, &d);
     char dig[DEC_KEEP];
     int k = d.nd - d.p - 1; /* decimal exponent of the first digit */
     k += dec_round(&d, sig, dig); /* a carry: 1 and zeros, cut to sig digits below */
