@@ -26,10 +26,6 @@ typedef struct {
 static const uint32_t k_pow10_u32[10] = {1u,      10u,      100u,      1000u,      10000u,
                                          100000u, 1000000u, 10000000u, 100000000u, 1000000000u};
 
-static const uint32_t k_pow5_u32[14] = {1u,      5u,       25u,       125u,       625u,
-                                        3125u,   15625u,   78125u,    390625u,    1953125u,
-                                        9765625u, 48828125u, 244140625u, 1220703125u};
-
 static void big_set(gs_big *b, uint64_t v)
 {
     b->w[0] = (uint32_t)v;
@@ -451,19 +447,12 @@ static void dec_expand(uint64_t mant, int e2, int p10, gs_dec *d)
     gs_big n;
     big_set(&n, mant);
     /* mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
-    uint32_t k = (uint32_t)(e2 < 0 ? -e2 : e2);
-    for (; k; k -= k < 13u ? k : 13u) {
-        uint32_t step = k < 13u ? k : 13u;
-        (void)big_mul_add(&n, e2 < 0 ? k_pow5_u32[step] : 1u << step, 0);
-    }
+    for (int k = e2 < 0 ? -e2 : e2; k > 0; k--) (void)big_mul_add(&n, e2 < 0 ? 5u : 2u, 0);
     d->p = p10 + (e2 < 0 ? -e2 : 0);
-    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower); the
-     * divisions are 32-bit: no 64-bit division routine linked */
+    /* a digit per pass over n, least significant first; the divisions are 32-bit: no
+     * 64-bit division routine linked */
     d->nd = 0;
-    while (n.n)
-        for (uint32_t r = big_divmod_small(&n, 10000u), j = 0; j < 4; j++, r /= 10u)
-            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
-    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
+    while (n.n) d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)big_divmod_small(&n, 10u);
 }
 
 /* the magnitude bits of a double (finite) as mant * 2^e2 (no frexp/ldexp, no double arithmetic) */
