@@ -288,12 +288,14 @@ static const struct {
 
 size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
 {
-    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
-    if (w.ok && (unsigned)ev->type >= sizeof k_nmea_lines / sizeof k_nmea_lines[0]) w.ok = false;
+    bool known = ev != NULL && (unsigned)ev->type < sizeof k_nmea_lines / sizeof k_nmea_lines[0];
+    gs_w w = {buf, cap, 0, buf != NULL && known};
     if (!w.ok) return w_finish(&w);
+    /* read once: the line's bytes may alias the event */
+    unsigned type = (unsigned)ev->type, end = k_nmea_lines[type].end;
     w_raw(&w, "$GS", 3);
-    w_raw(&w, k_nmea_lines[ev->type].tag, 3);
-    for (unsigned i = k_nmea_lines[ev->type].first; i < k_nmea_lines[ev->type].end; i++) {
+    w_raw(&w, k_nmea_lines[type].tag, 3);
+    for (unsigned i = k_nmea_lines[type].first; i < end; i++) {
         w_raw(&w, ",", 1);
         w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
     }
