@@ -40,6 +40,10 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals);
  * holds ""). */
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals);
 
+/* Format v in decimal. Writes a NUL. Returns chars written (without the NUL), or 0 when
+ * cap is too small (buf then holds ""). */
+size_t gs_num_fmt_u32(char *buf, size_t cap, uint32_t v);
+
 /* Format a finite v with `sig` (1..15) significant digits, in plain notation
  * when 1e-4 <= |v| < 1e15, otherwise as d.ddde-XX; trailing zeros trimmed.
  * Rounded half away from zero, except where that would exceed the double range

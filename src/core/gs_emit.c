@@ -77,18 +77,6 @@ static size_t w_finish(gs_w *w)
     return w->len;
 }
 
-/* v in decimal; width > 0: nothing when it needs more characters (NMEA fields) */
-static void w_u32(gs_w *w, uint32_t v, size_t width)
-{
-    char t[12];
-    size_t n = sizeof t;
-    do {
-        t[--n] = (char)('0' + v % 10u);
-        v /= 10u;
-    } while (v);
-    if (!width || sizeof t - n <= width) w_raw(w, t + n, sizeof t - n);
-}
-
 /* the gs_real at p as a double: exact (where gs_real is float, from its bits: no libgcc conversion) */
 static double real_at(const void *p)
 {
@@ -129,10 +117,19 @@ _Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field
 
 static const void *field_at(const void *base, const field *f) { return (const char *)base + f->off; }
 
-/* the number of kind V_FIXED (gs_real), V_FLOAT (float) or V_TIME (int64_t microseconds,
- * as seconds) at p with `decimals` decimals: a float from its bits, no double emulated */
+static uint32_t u32_at(const void *p)
+{
+    uint32_t v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/* the number of kind V_U32 (uint32_t, no decimals), V_FIXED (gs_real), V_FLOAT (float) or
+ * V_TIME (int64_t microseconds, as seconds) at p with `decimals` decimals: a float from
+ * its bits, no double emulated */
 static size_t fmt_number(char *t, size_t cap, int kind, const void *p, int decimals)
 {
+    if (kind == V_U32) return gs_num_fmt_u32(t, cap, u32_at(p));
     if (kind == V_TIME) {
         int64_t us;
         memcpy(&us, p, sizeof us);
@@ -163,13 +160,6 @@ static bool w_number(gs_w *w, int kind, const void *p, int decimals, size_t widt
     return false;
 }
 
-static uint32_t u32_at(const void *p)
-{
-    uint32_t v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
-
 /* ------------------------------------------------------------------ NMEA */
 
 /* NMEA text fields may not hold the delimiters $ * , ! \ ^ ~ or non-printables */
@@ -194,7 +184,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
     char c[2];
     size_t n = 0;
     switch (f->kind) {
-    case V_U32: w_u32(w, u32_at(p), f->b); return;
+    case V_U32:
     case V_FIXED:
     case V_TIME: (void)w_number(w, f->kind, p, f->a, f->b); return;
     case V_FLAG: {
@@ -402,7 +392,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         if (n) w_raw(w, t, n);
         else w_lit(w, "null");
         break;
-    case V_U32: w_u32(w, u32_at(p), 0); break;
+    case V_U32:
     case V_FIXED:
     case V_TIME:
     case V_FLOAT:

@@ -571,6 +571,11 @@ size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
     return fmt_dec(buf, cap, mag, 0, 6, t_us < 0, decimals);
 }
 
+size_t gs_num_fmt_u32(char *buf, size_t cap, uint32_t v)
+{
+    return fmt_dec(buf, cap, v, 0, 0, false, 0);
+}
+
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
 {
     uint64_t mag = gs_dbits_abs(v);
