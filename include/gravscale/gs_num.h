@@ -29,12 +29,20 @@ bool gs_num_parse_int(const char *s, size_t len, long *out);
  * or cap is too small (buf then holds ""). */
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals);
 
+/* gs_num_fmt_fixed of the float v's exact value, from its bits: where doubles are
+ * emulated (a Cortex-M4F) no widening to double. */
+size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals);
+
 /* Format t_us microseconds as seconds with exactly `decimals` (0..9) digits after
  * the point, rounded half away from zero (exact: from the integer's decimal digits),
  * "-0.000" printed as "0.000". Writes a NUL. Returns chars written (without the NUL),
  * or 0 when t_us is INT64_MIN (GS_T_NONE, gs_time.h) or cap is too small (buf then
  * holds ""). */
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals);
+
+/* Format v in decimal. Writes a NUL. Returns chars written (without the NUL), or 0 when
+ * cap is too small (buf then holds ""). */
+size_t gs_num_fmt_u32(char *buf, size_t cap, uint32_t v);
 
 /* Format a finite v with `sig` (1..15) significant digits, in plain notation
  * when 1e-4 <= |v| < 1e15, otherwise as d.ddde-XX; trailing zeros trimmed.

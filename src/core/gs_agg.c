@@ -171,11 +171,10 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
     }
     gs_real med = gs_sort_median(v, n);
     out->height_m = med;
-    gs_real rms_se = n_se > 0 ? GS_SQRT(se2_sum / n_se) : (gs_real)NAN;
+    /* the fits' SEs (their RMS: a sum of squares is never NaN), 0 when none is known */
+    gs_real se_floor = n_se > 0 ? GS_SQRT(se2_sum / n_se) : GS_R(0.0);
 
     gs_real half;
-    /* the fits' SEs, 0 when none is known */
-    gs_real se_floor = isnan(rms_se) ? GS_R(0.0) : rms_se;
     if (n == 1) {
         gs_real tau = SINGLE_FLIGHT_REL_SPREAD * med;
         half = GS_R(1.96) * GS_SQRT(se_floor * se_floor + tau * tau);

@@ -77,50 +77,6 @@ static size_t w_finish(gs_w *w)
     return w->len;
 }
 
-/* v in decimal; width > 0: nothing when it needs more characters (NMEA fields) */
-static void w_u32(gs_w *w, uint32_t v, size_t width)
-{
-    char t[12];
-    size_t n = sizeof t;
-    do {
-        t[--n] = (char)('0' + v % 10u);
-        v /= 10u;
-    } while (v);
-    if (!width || sizeof t - n <= width) w_raw(w, t + n, sizeof t - n);
-}
-
-/* v with `decimals` decimals. width 0 (JSON): null when v is not finite or beyond
- * 1e15. width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the
- * text is wider, nothing when v is unknown or cannot fit. */
-static void w_fixed(gs_w *w, double v, int decimals, size_t width)
-{
-    char t[40];
-    for (int d = decimals; d >= 0; d--) {
-        size_t n = gs_num_fmt_fixed(t, sizeof t, v, d);
-        if (n && (!width || n <= width)) {
-            w_raw(w, t, n);
-            return;
-        }
-        if (!width) break;
-    }
-    if (!width) w_lit(w, "null");
-}
-
-/* t_us as seconds with `decimals` decimals, otherwise as w_fixed (GS_T_NONE: unknown) */
-static void w_time(gs_w *w, int64_t t_us, int decimals, size_t width)
-{
-    char t[40];
-    for (int d = decimals; d >= 0; d--) {
-        size_t n = gs_num_fmt_us(t, sizeof t, t_us, d);
-        if (n && (!width || n <= width)) {
-            w_raw(w, t, n);
-            return;
-        }
-        if (!width) break;
-    }
-    if (!width) w_lit(w, "null");
-}
-
 /* the gs_real at p as a double: exact (where gs_real is float, from its bits: no libgcc conversion) */
 static double real_at(const void *p)
 {
@@ -161,24 +117,47 @@ _Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field
 
 static const void *field_at(const void *base, const field *f) { return (const char *)base + f->off; }
 
-/* the kinds both formats use; false for the others */
-static bool w_common(gs_w *w, const void *base, const field *f)
+static uint32_t u32_at(const void *p)
 {
-    const void *p = field_at(base, f);
-    if (f->kind == V_U32) {
-        uint32_t v;
-        memcpy(&v, p, sizeof v);
-        w_u32(w, v, f->b);
-    } else if (f->kind == V_FIXED) {
-        w_fixed(w, real_at(p), f->a, f->b);
-    } else if (f->kind == V_TIME) {
-        int64_t t;
-        memcpy(&t, p, sizeof t);
-        w_time(w, t, f->a, f->b);
-    } else {
-        return false;
+    uint32_t v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/* the number of kind V_U32 (uint32_t, no decimals), V_FIXED (gs_real), V_FLOAT (float) or
+ * V_TIME (int64_t microseconds, as seconds) at p with `decimals` decimals: a float from
+ * its bits, no double emulated */
+static size_t fmt_number(char *t, size_t cap, int kind, const void *p, int decimals)
+{
+    if (kind == V_U32) return gs_num_fmt_u32(t, cap, u32_at(p));
+    if (kind == V_TIME) {
+        int64_t us;
+        memcpy(&us, p, sizeof us);
+        return gs_num_fmt_us(t, cap, us, decimals);
     }
-    return true;
+    if (kind == V_FLOAT || GS_REAL_IS_FLOAT) {
+        float x;
+        memcpy(&x, p, sizeof x);
+        return gs_num_fmt_fixed_f(t, cap, x, decimals);
+    }
+    return gs_num_fmt_fixed(t, cap, real_at(p), decimals);
+}
+
+/* That number; false (nothing written) when it is unknown, not finite or beyond 1e15.
+ * width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the text is
+ * wider, false when it cannot fit. */
+static bool w_number(gs_w *w, int kind, const void *p, int decimals, size_t width)
+{
+    char t[40];
+    for (int d = decimals; d >= 0; d--) {
+        size_t n = fmt_number(t, sizeof t, kind, p, d);
+        if (n && (!width || n <= width)) {
+            w_raw(w, t, n);
+            return true;
+        }
+        if (!width) break;
+    }
+    return false;
 }
 
 /* ------------------------------------------------------------------ NMEA */
@@ -201,11 +180,13 @@ static const char k_hex_upper[] = "0123456789ABCDEF";
 /* after its comma */
 static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
 {
-    if (w_common(w, base, f)) return;
     const void *p = field_at(base, f);
     char c[2];
     size_t n = 0;
     switch (f->kind) {
+    case V_U32:
+    case V_FIXED:
+    case V_TIME: (void)w_number(w, f->kind, p, f->a, f->b); return;
     case V_FLAG: {
         bool b;
         memcpy(&b, p, sizeof b);
@@ -226,8 +207,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
         break;
     }
     case V_HEX8: { /* the GS_WARN_* bits in hex */
-        uint32_t b;
-        memcpy(&b, p, sizeof b);
+        uint32_t b = u32_at(p);
         c[n++] = k_hex_upper[(b >> 4) & 15u];
         c[n++] = k_hex_upper[b & 15u];
         break;
@@ -298,12 +278,14 @@ static const struct {
 
 size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
 {
-    gs_w w = {buf, cap, 0, buf != NULL && ev != NULL};
-    if (w.ok && (unsigned)ev->type >= sizeof k_nmea_lines / sizeof k_nmea_lines[0]) w.ok = false;
+    bool known = ev != NULL && (unsigned)ev->type < sizeof k_nmea_lines / sizeof k_nmea_lines[0];
+    gs_w w = {buf, cap, 0, buf != NULL && known};
     if (!w.ok) return w_finish(&w);
+    /* read once: the line's bytes may alias the event */
+    unsigned type = (unsigned)ev->type, end = k_nmea_lines[type].end;
     w_raw(&w, "$GS", 3);
-    w_raw(&w, k_nmea_lines[ev->type].tag, 3);
-    for (unsigned i = k_nmea_lines[ev->type].first; i < k_nmea_lines[ev->type].end; i++) {
+    w_raw(&w, k_nmea_lines[type].tag, 3);
+    for (unsigned i = k_nmea_lines[type].first; i < end; i++) {
         w_raw(&w, ",", 1);
         w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
     }
@@ -373,16 +355,21 @@ static void w_warnings(gs_w *w, uint32_t bits)
     w_raw(w, "]", 1);
 }
 
+/* a number, or null */
+static void w_json_number(gs_w *w, int kind, const void *p, int decimals)
+{
+    if (!w_number(w, kind, p, decimals, 0)) w_lit(w, "null");
+}
+
 /* [lo,hi], or null: an interval with an unknown end is no interval */
 static void w_ci95(gs_w *w, const void *mid_lo_hi)
 {
-    double v[3];
-    for (int i = 0; i < 3; i++) v[i] = real_at((const gs_real *)mid_lo_hi + i);
-    if (gs_dfinite(v[1]) && gs_dfinite(v[2]) && gs_dfinite(v[0])) {
+    const gs_real *v = mid_lo_hi;
+    if (gs_dfinite(real_at(v + 1)) && gs_dfinite(real_at(v + 2)) && gs_dfinite(real_at(v))) {
         w_raw(w, "[", 1);
-        w_fixed(w, v[1], 4, 0);
+        w_json_number(w, V_FIXED, v + 1, 4);
         w_raw(w, ",", 1);
-        w_fixed(w, v[2], 4, 0);
+        w_json_number(w, V_FIXED, v + 2, 4);
         w_raw(w, "]", 1);
     } else {
         w_lit(w, "null");
@@ -393,10 +380,8 @@ static const char *const k_json_bool[][2] = {{"true", "false"}, {"\"end\"", "\"s
 
 static void w_json_value(gs_w *w, const void *base, const field *f)
 {
-    if (w_common(w, base, f)) return;
     const void *p = field_at(base, f);
     double d;
-    float x;
     const char *s;
     bool b;
     switch (f->kind) {
@@ -407,9 +392,11 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         if (n) w_raw(w, t, n);
         else w_lit(w, "null");
         break;
+    case V_U32:
+    case V_FIXED:
+    case V_TIME:
     case V_FLOAT:
-        memcpy(&x, p, sizeof x);
-        w_fixed(w, gs_dwiden(x), f->a, 0);
+        w_json_number(w, f->kind, p, f->a);
         break;
     case V_STR:
         memcpy(&s, p, sizeof s);
@@ -425,9 +412,7 @@ static void w_json_value(gs_w *w, const void *base, const field *f)
         break;
     }
     case V_WARNINGS: {
-        uint32_t bits;
-        memcpy(&bits, p, sizeof bits);
-        w_warnings(w, bits);
+        w_warnings(w, u32_at(p));
         break;
     }
     default: w_ci95(w, p); break;

@@ -26,10 +26,6 @@ typedef struct {
 static const uint32_t k_pow10_u32[10] = {1u,      10u,      100u,      1000u,      10000u,
                                          100000u, 1000000u, 10000000u, 100000000u, 1000000000u};
 
-static const uint32_t k_pow5_u32[14] = {1u,      5u,       25u,       125u,       625u,
-                                        3125u,   15625u,   78125u,    390625u,    1953125u,
-                                        9765625u, 48828125u, 244140625u, 1220703125u};
-
 static void big_set(gs_big *b, uint64_t v)
 {
     b->w[0] = (uint32_t)v;
@@ -445,41 +441,28 @@ typedef struct {
     int p;
 } gs_dec;
 
-/* the decimal digits of n > 0 (consumed) into d, worth n * 10^-p */
-static void dec_digits(gs_big *n, int p, gs_dec *d)
+/* the decimal digits of a = mant * 2^e2 * 10^-p10 (mant > 0) into d */
+static void dec_expand(uint64_t mant, int e2, int p10, gs_dec *d)
 {
-    d->p = p;
-    /* 4 digits per pass over n (a digit per pass made long expansions 4x slower) */
-    d->nd = 0;
-    while (n->n)
-        for (uint32_t r = big_divmod_small(n, 10000u), j = 0; j < 4; j++, r /= 10u)
-            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
-    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top chunk's leading zeros */
-}
-
-static void dec_expand(uint64_t abs_bits, gs_dec *d)
-{
-    /* a = mant * 2^e2 from the IEEE bits (no frexp/ldexp, no double arithmetic) */
-    int be = (int)(abs_bits >> 52);
-    uint64_t mant = abs_bits & ((1ull << 52) - 1u);
-    int e2 = -1074; /* subnormal */
-    if (be) {
-        mant |= 1ull << 52;
-        e2 = be - 1075;
-    }
-    while (!(mant & 1u)) {
-        mant >>= 1;
-        e2++;
-    }
     gs_big n;
     big_set(&n, mant);
-    /* a = mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
-    uint32_t k = (uint32_t)(e2 < 0 ? -e2 : e2);
-    for (; k; k -= k < 13u ? k : 13u) {
-        uint32_t step = k < 13u ? k : 13u;
-        (void)big_mul_add(&n, e2 < 0 ? k_pow5_u32[step] : 1u << step, 0);
-    }
-    dec_digits(&n, e2 < 0 ? -e2 : 0, d);
+    /* mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
+    for (int k = e2 < 0 ? -e2 : e2; k > 0; k--) (void)big_mul_add(&n, e2 < 0 ? 5u : 2u, 0);
+    d->p = p10 + (e2 < 0 ? -e2 : 0);
+    /* a digit per pass over n, least significant first; the divisions are 32-bit: no
+     * 64-bit division routine linked */
+    d->nd = 0;
+    while (n.n) d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)big_divmod_small(&n, 10u);
+}
+
+/* the magnitude bits of a double (finite) as mant * 2^e2 (no frexp/ldexp, no double arithmetic) */
+static uint64_t dbits_mant(uint64_t abs_bits, int *e2)
+{
+    int be = (int)(abs_bits >> 52);
+    uint64_t mant = abs_bits & ((1ull << 52) - 1u);
+    if (be) mant |= 1ull << 52;
+    *e2 = be ? be - 1075 : -1074;
+    return mant;
 }
 
 /* digit i counted from the most significant (0); zeros past the end */
@@ -537,15 +520,18 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
     return n;
 }
 
-/* |value| = D * 10^-p from d (NULL: 0) with `decimals` decimals, rounded half away
- * from zero, a minus sign when neg and the rounded value is not 0 */
-static size_t fmt_dec(char *buf, size_t cap, const gs_dec *d, bool neg, int decimals)
+/* |value| = mant * 2^e2 * 10^-p10 with `decimals` decimals, rounded half away from
+ * zero, a minus sign when neg and the rounded value is not 0; "" unless 0 <= decimals <= 9 */
+static size_t fmt_dec(char *buf, size_t cap, uint64_t mant, int e2, int p10, bool neg, int decimals)
 {
+    if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
     int nr = 0;
-    if (d) {
-        int count = d->nd - d->p + decimals; /* digits at or above 10^-decimals */
-        if (count >= 0) nr = count + dec_round(d, count, dig);
+    if (mant) {
+        gs_dec d;
+        dec_expand(mant, e2, p10, &d);
+        int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
+        if (count >= 0) nr = count + dec_round(&d, count, dig);
     }
     char t[48];
     size_t n = put_digits(t, nr && neg, dig, nr, nr - decimals, decimals);
@@ -556,24 +542,38 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
-    gs_dec d;
-    if (mag) dec_expand(mag, &d);
-    return fmt_dec(buf, cap, mag ? &d : NULL, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+    if (mag >= gs_dbits(1e15)) return put_out(buf, cap, "", FMT_FAIL);
+    int e2;
+    uint64_t mant = dbits_mant(mag, &e2);
+    return fmt_dec(buf, cap, mant, e2, 0, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+}
+
+size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    uint32_t mag = bits & 0x7FFFFFFFu;
+    float below_1e15 = 1e15f; /* the float nearest 1e15 is the largest below it */
+    uint32_t limit;
+    memcpy(&limit, &below_1e15, sizeof limit);
+    /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
+    if (mag > limit) return put_out(buf, cap, "", FMT_FAIL);
+    /* |v| = mant * 2^e2 from the IEEE bits, as dbits_mant */
+    uint32_t be = mag >> 23, mant = mag & 0x7FFFFFu;
+    if (be) mant |= 0x800000u;
+    return fmt_dec(buf, cap, mant, be ? (int)be - 150 : -149, 0, (bits >> 31) != 0u, decimals);
 }
 
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
 {
-    if (t_us == INT64_MIN || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
+    if (t_us == INT64_MIN) return put_out(buf, cap, "", FMT_FAIL);
     uint64_t mag = t_us < 0 ? (uint64_t)-t_us : (uint64_t)t_us;
-    gs_dec d;
-    if (mag) {
-        /* the digits by 32-bit divisions: no 64-bit division routine linked */
-        gs_big n;
-        big_set(&n, mag);
-        dec_digits(&n, 6, &d);
-    }
-    return fmt_dec(buf, cap, mag ? &d : NULL, t_us < 0, decimals);
+    return fmt_dec(buf, cap, mag, 0, 6, t_us < 0, decimals);
+}
+
+size_t gs_num_fmt_u32(char *buf, size_t cap, uint32_t v)
+{
+    return fmt_dec(buf, cap, v, 0, 0, false, 0);
 }
 
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
@@ -582,7 +582,9 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     if (mag >= GS_DBITS_INF || sig < 1 || sig > 15) return put_out(buf, cap, "", FMT_FAIL);
     if (!mag) return put_out(buf, cap, "0", 1u);
     gs_dec d;
-    dec_expand(mag, &d);
+    int e2;
+    uint64_t mant = dbits_mant(mag, &e2);
+    dec_expand(mant, e2, 0, &d);
     char dig[DEC_KEEP];
     int k = d.nd - d.p - 1; /* decimal exponent of the first digit */
     k += dec_round(&d, sig, dig); /* a carry: 1 and zeros, cut to sig digits below */

@@ -37,10 +37,8 @@ static uint16_t size_pack(float size_px)
     if (size_px < SIZE_FINE_PX - 1.0f / 32.0f) {
         return (uint16_t)(size_px * 16.0f + 0.5f);
     }
+    /* size_px >= SIZE_FINE_PX - 1/32 (exact differences near it): q >= 0.375 */
     float q = (size_px - SIZE_FINE_PX) * 4.0f + 0.5f;
-    if (q < 0.0f) {
-        q = 0.0f;
-    }
     /* larger than any sensor: unknown rather than a wrong number */
     if (!(q < (float)(SIZE_UNKNOWN - SIZE_FINE_Q))) {
         return SIZE_UNKNOWN;

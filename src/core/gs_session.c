@@ -30,9 +30,11 @@ void gs_session_init(gs_session *s, int64_t absence_us, gs_real new_body_rel)
     reset_visit(s);
 }
 
-/* the median of GS_SESSION_REF_N sizes */
-static gs_real median_ref(const float *v)
+/* the median of GS_SESSION_REF_N sizes (sorted in place where gs_real is float: they
+ * are not read again) */
+static gs_real median_ref(float *v)
 {
+    if (GS_REAL_IS_FLOAT) return gs_sort_median((gs_real *)(void *)v, GS_SESSION_REF_N);
     gs_real t[GS_SESSION_REF_N];
     for (uint32_t i = 0; i < GS_SESSION_REF_N; i++) t[i] = v[i];
     return gs_sort_median(t, GS_SESSION_REF_N);

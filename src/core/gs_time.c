@@ -36,11 +36,12 @@ int64_t gs_time_us_of_cfg_s(float s)
     uint32_t ex = (b >> 23) & 0xFFu;
     if (ex == 0u) return 0;  /* +-0 and subnormals: far below half a microsecond */
     /* s x 1e6 = m 1e6 2^(ex-150) = q 2^-r with q = m 1e6 2^7 < 2^51 and 0 <= r = 157 - ex
-     * (ex <= 157 below 2^31 s); one rounding shift, half up: (2q + 2^r) >> (r + 1) */
+     * (ex <= 157 below 2^31 s); one rounding shift, half up: (2q + 2^r) >> (r + 1), which
+     * is ((2q >> r) + 1) >> 1 (the bits below 2^r cannot carry into the half) */
     uint64_t q = (uint64_t)((b & 0x7FFFFFu) | 0x800000u) * (uint64_t)GS_US_PER_S << 7;
     uint32_t r = 157u - ex;
     if (r > 52u) return 0;  /* below 2^-1 us */
-    return (int64_t)(((q << 1) + (UINT64_C(1) << r)) >> (r + 1u));
+    return (int64_t)(((q << 1 >> r) + 1u) >> 1);
 }
 
 int64_t gs_time_us_of_s(double t_s)
