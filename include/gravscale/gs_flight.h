@@ -50,7 +50,7 @@ typedef void (*gs_event_fn)(void *ctx, const gs_event *ev);
 #endif
 
 #if GS_CLOSE_LAG_FRAMES > 0
-/* The last robust fit of a close (gs_flight.c): the same window fitted again gets its result */
+/* The last robust fit of a decision (gs_flight.c): the same window fitted again gets its result */
 typedef struct {
     bool valid;
     uint32_t first, count;
@@ -91,7 +91,6 @@ typedef struct {
     int32_t T0_lus, T1_lus, F0_lus, F1_lus; /* the boundaries */
     gs_fit_result r;           /* the flight's fit as grown */
 #if GS_CLOSE_LAG_FRAMES > 0
-    gs_fit_memo memo;
     uint32_t low;              /* the oldest sample it may read (it must stay in the ring) */
     int64_t t_end_us;          /* the time of the sample newest */
     bool alarm_due;            /* the take-off side's walk stopped at an alarm awaiting its refit */
@@ -181,6 +180,7 @@ typedef struct {
     uint32_t wait_alarm;       /* ... the contact alarm it landed with */
 #if GS_CLOSE_LAG_FRAMES > 0
     gs_close close;            /* the pending close: no sample is examined until it is done */
+    gs_fit_memo memo;          /* the last robust fit of the current decision (a close's spans frames) */
     bool close_whole;          /* every close runs whole in its landing's frame */
     gs_feet_frame feet_held[GS_CLOSE_LAG_FRAMES]; /* the feet of the frames since, oldest first */
     uint32_t feet_held_n;

@@ -362,7 +362,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
-    gs_feet_init(&f->feet, 0.0f, true);
+    /* (f->feet is read only where gs_flight_use_feet set it up: FEET_ON) */
     f->last_land_us = GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
     return GS_OK;
@@ -637,33 +637,28 @@ static NOINLINE uint32_t history_floor(const gs_flight *f)
     return f->quiet_from > oldest ? f->quiet_from : oldest;
 }
 
-/* The last robust fit of one decision (a landing and its close): the same window fitted
- * again gets its result, and f->keep still holds its flags (every robust fit in
- * between goes through the memo). */
+/* A decision (a landing and its close, a seed's core, an alarm's refit) begins: the memo
+ * (gs_flight.h) forgets the fits of the one before. */
+static void memo_forget(gs_flight *f)
+{
 #if GS_CLOSE_LAG_FRAMES > 0
-typedef gs_fit_memo fit_memo;  /* a pending close keeps its memo (gs_flight.h) */
+    f->memo.valid = false;
 #else
-typedef struct {
-    bool valid;
-#ifndef __OPTIMIZE_SIZE__
-    uint32_t first;
-    uint32_t count;
-    float min_scale;
-    gs_fit_method method;
-    gs_status st;
-    gs_fit_result r;
+    (void)f;
 #endif
-} fit_memo;
-#endif
+}
 
-/* gs_fit_robust of ring samples [first, first+count) into f->keep, once per memo */
-static NOINLINE gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, uint32_t count, gs_fit_method method,
+/* gs_fit_robust of ring samples [first, first+count) into f->keep; with a lag, once per
+ * decision: the same window fitted again gets its result, and f->keep still holds its
+ * flags (every robust fit in between goes through the memo) */
+static NOINLINE gs_status robust_fit(gs_flight *f, uint32_t first, uint32_t count, gs_fit_method method,
                             float min_scale, gs_fit_result *r)
 {
-#ifdef __OPTIMIZE_SIZE__
-    (void)m;  /* the firmware's code budget is full: it fits again */
+#if GS_CLOSE_LAG_FRAMES == 0
+    /* every close runs whole in one call (the firmware, whose code budget is full): it fits again */
     return gs_fit_robust(f->ring, ring_idx(f, first), count, method, min_scale, f->keep, r);
 #else
+    gs_fit_memo *m = &f->memo;
     if (m->valid && m->first == first && m->count == count && m->method == method && m->min_scale == min_scale) {
         *r = m->r;
         return m->st;
@@ -681,13 +676,13 @@ static NOINLINE gs_status robust_fit(gs_flight *f, fit_memo *m, uint32_t first, 
 
 /* Rebuild the running fit robustly from the ring samples [lo, hi]; *r: its solution
  * when true (scratch otherwise). */
-static bool refit_range(gs_flight *f, fit_memo *m, uint32_t lo, uint32_t hi, gs_fit_result *r)
+static bool refit_range(gs_flight *f, uint32_t lo, uint32_t hi, gs_fit_result *r)
 {
     int32_t t_lo = lt_at(f, lo), t_hi = lt_at(f, hi);
     if (t_lo == GS_LT_NONE || t_hi == GS_LT_NONE || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    if (robust_fit(f, m, lo, count, GS_FIT_IRLS, min_scale, r) != GS_OK)
+    if (robust_fit(f, lo, count, GS_FIT_IRLS, min_scale, r) != GS_OK)
         return false;
     int32_t tspan = t_hi - t_lo;  /* (two held samples) */
     gs_fit_init(&f->fit, abs_of(f, t_lo + tspan / 2), tspan > 0 ? tspan : frame_dt_us(f));
@@ -702,10 +697,10 @@ static bool refit_range(gs_flight *f, fit_memo *m, uint32_t lo, uint32_t hi, gs_
 /* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
  * the alarm: if the samples at the edge then sit on the parabola, it was a
  * false alarm (true contact deviates by far more than a refit can absorb). */
-static bool alarm_is_false(gs_flight *f, fit_memo *m, uint32_t lo, uint32_t hi, uint32_t edge, int side)
+static bool alarm_is_false(gs_flight *f, uint32_t lo, uint32_t hi, uint32_t edge, int side)
 {
     gs_fit_result r;
-    if (!refit_range(f, m, lo, hi, &r)) return false;
+    if (!refit_range(f, lo, hi, &r)) return false;
     /* a refit that only fits with a residual far above the noise proves nothing */
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
@@ -737,8 +732,8 @@ static bool seed_core_width(gs_flight *f, uint32_t apex, uint32_t newest, int64_
         if (hi < newest) hi++;
     }
     gs_fit_result r;
-    fit_memo m = {0};
-    if (!refit_range(f, &m, lo, hi, &r)) return false;
+    memo_forget(f);
+    if (!refit_range(f, lo, hi, &r)) return false;
     uint32_t n_usable = count_usable(f, lo, hi);
     /* a core the robust fit had to cut down to a few samples is not a curve yet */
     bool enough = r.n >= 5 && 4u * r.n >= 3u * n_usable;
@@ -1107,7 +1102,7 @@ static gs_real rigid_size(const gs_flight *f, uint32_t lo, uint32_t hi, gs_real 
  * CUSUM was back at zero, and the fit is rebuilt over the clean range at the end
  * (GS_CLOSE_GROWN). all: walk to the end; else stop after an alarm's refit, or before
  * one once the walk took WALK_FREE samples. True when it ran a refit or stopped for one. */
-static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, bool *spent)
+static uint8_t grow_left_step(gs_flight *f, gs_close *c, bool all, bool *spent)
 {
     uint32_t floor_idx = history_floor(f);
     int32_t t_seed = lt_at(f, f->seed_idx);
@@ -1155,7 +1150,7 @@ static uint8_t grow_left_step(gs_flight *f, gs_close *c, fit_memo *m, bool all, 
         /* contact at walk_i, or a refit through it shows a false alarm */
         uint32_t i = c->walk_i;
         *spent = true;
-        if (!alarm_is_false(f, m, i, f->fl_last, i, -1)) {
+        if (!alarm_is_false(f, i, f->fl_last, i, -1)) {
             c->left_alarm = i;
             return GS_CLOSE_GROWN;
         }
@@ -1377,20 +1372,19 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
 }
 
 /* GS_CLOSE_FINAL: the final robust fit over the flight's samples, the judgement and the event */
-static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
+static uint8_t close_final(gs_flight *f, gs_close *c)
 {
     uint32_t land_idx = GS_NO_IDX;  /* first sample after the flight */
     int32_t T0 = c->T0_lus, T1 = c->T1_lus;
     uint32_t in_lo = c->in_lo, in_hi = c->in_hi;
-    gs_sample_full sf_b, sl_b;
-    const gs_sample_full *sf = at(f, in_lo, &sf_b), *sl = at(f, in_hi, &sl_b);
-    if (!sf || !sl || in_hi < in_lo) goto done;
+    int32_t t_first = lt_at(f, in_lo), t_last = lt_at(f, in_hi);  /* the outermost flight samples */
+    if (t_first == GS_LT_NONE || t_last == GS_LT_NONE) goto done;  /* (in_lo <= in_hi: trim_edge keeps them within [lo, hi] in order) */
     land_idx = in_hi + 1;
     uint32_t count = (uint32_t)(in_hi - in_lo + 1);
     gs_fit_result fr;
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
-    gs_status st = robust_fit(f, m, in_lo, count, CFG(f)->fit_method, min_scale, &fr);
-    trace_fit(f, "final", sf->t_us, sl->t_us, st == GS_OK ? &fr : NULL);
+    gs_status st = robust_fit(f, in_lo, count, CFG(f)->fit_method, min_scale, &fr);
+    trace_fit(f, "final", abs_of(f, t_first), abs_of(f, t_last), st == GS_OK ? &fr : NULL);
     if (st != GS_OK) goto done;  /* nothing fits: not a flight worth reporting */
 
     /* samples actually inside the flight (usable) and rejected as outliers */
@@ -1411,8 +1405,8 @@ static uint8_t close_final(gs_flight *f, gs_close *c, fit_memo *m)
 
     /* sub-frame times: fall back to half a frame outside the outermost flight sample */
     int32_t half_dt = frame_dt_us(f) / 2;
-    if (T0 == GS_LT_NONE) T0 = lt_of(f, sf->t_us) - half_dt;
-    if (T1 == GS_LT_NONE) T1 = lt_of(f, sl->t_us) + half_dt;
+    if (T0 == GS_LT_NONE) T0 = t_first - half_dt;
+    if (T1 == GS_LT_NONE) T1 = t_last + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
     bool feet = GS_WITH_POSE && c->feet;  /* (no layout with feet: their code folds away) */
     int32_t F1 = GS_WITH_POSE ? c->F1_lus : GS_LT_NONE;
@@ -1549,28 +1543,23 @@ static void seed_found(gs_flight *f, uint32_t newest);
  * boundary search. */
 static void close_run(gs_flight *f, gs_close *c, bool all)
 {
-#if GS_CLOSE_LAG_FRAMES > 0
-    fit_memo *m = &c->memo;
-#else
-    fit_memo memo = {0}, *m = &memo;  /* without a lag every close runs whole in one call */
-#endif
     bool spent = false;
     uint8_t stage = c->stage;
     while (stage != GS_CLOSE_NONE && (all || !spent)) {
         switch (stage) {
         case GS_CLOSE_REFIT: {  /* the running fit may hold samples past the edge: rebuild it over the flight */
             gs_fit_result r;
-            refit_range(f, m, f->fl_first, f->fl_last, &r);
+            refit_range(f, f->fl_first, f->fl_last, &r);
             stage = GS_CLOSE_START;
             spent = true;
             break;
         }
         case GS_CLOSE_START: stage = close_start(f, c); break;
-        case GS_CLOSE_GROW: stage = grow_left_step(f, c, m, all, &spent); break;
+        case GS_CLOSE_GROW: stage = grow_left_step(f, c, all, &spent); break;
         case GS_CLOSE_GROWN: {
             f->fl_first = c->clean;
             gs_fit_result rr;  /* r changes only when the refit succeeds */
-            if (refit_range(f, m, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, &c->r);
+            if (refit_range(f, f->fl_first, f->fl_last, &rr)) gs_fit_solve(&f->fit, &c->r);
             stage = GS_CLOSE_BOUNDS;
             spent = true;
             break;
@@ -1588,7 +1577,7 @@ static void close_run(gs_flight *f, gs_close *c, bool all)
             }
             break;
 #endif
-        default: stage = close_final(f, c, m); break;
+        default: stage = close_final(f, c); break;
         }
     }
     c->stage = stage;
@@ -1604,9 +1593,7 @@ static void close_begin(gs_flight *f, gs_close *c, uint32_t newest, uint32_t rig
     c->truncated = truncated;
     c->head = idx_of(f, gs_ring_head(f->ring));
     c->stage = refit ? GS_CLOSE_REFIT : GS_CLOSE_START;
-#if GS_CLOSE_LAG_FRAMES > 0
-    c->memo.valid = false;
-#endif
+    memo_forget(f);
 }
 
 #if GS_CLOSE_LAG_FRAMES > 0
@@ -1990,8 +1977,7 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
         alarm = f->wait_alarm;
         goto landed;
     }
-    gs_fit_result r;
-    if (idx <= f->fl_last) return;  /* already in the seed's core */
+    gs_fit_result r;  /* (idx > fl_last: samples come after the seed's core, in order) */
     int32_t t = lt_of(f, s->t_us);
     if (gs_fit_solve(&f->fit, &r) != GS_OK || span_over(t, lt_at(f, f->seed_idx), f->max_flight_us))
         goto landed;
@@ -2013,8 +1999,8 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
     if (f->cusum > GS_R(0.0) && span_over(t, lt_at(f, f->fl_last), f->landing_latency_us))
         goto landed;
     if (contact) {  /* decelerated by the ground: landed? */
-        fit_memo m = {0};
-        if (!alarm_is_false(f, &m, f->fl_first, idx, idx, +1)) goto landed;
+        memo_forget(f);
+        if (!alarm_is_false(f, f->fl_first, idx, idx, +1)) goto landed;
         f->fl_last = idx;   /* the refit took every sample through idx */
         f->cusum = GS_R(0.0);
         f->pend_ok = 0;
