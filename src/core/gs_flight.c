@@ -140,8 +140,6 @@ static bool usable(const gs_sample_full *s)
     return s && s->w >= USABLE_W_MIN && gs_finite2_f(s->x_px, s->y_px);
 }
 
-static bool held(const gs_flight *f, uint32_t i) { return gs_ring_at(f->ring, ring_idx(f, i)) != NULL; }
-
 /* t1 - t0 longer than a span (false when either time is unknown); both are held samples'
  * times, less than 2^31 us apart */
 static NOINLINE bool span_over(int32_t t1_lus, int32_t t0_lus, int32_t span_us)
@@ -905,8 +903,9 @@ static gs_real piecewise_ssr(const gs_flight *f, uint32_t lo, uint32_t hi, int32
         gs_real d = past_s(t, T, side);
         gs_real h = d > GS_R(0.0) ? GS_R(0.5) * d * d / ts2 : GS_R(0.0);
         gs_real x[4] = {GS_R(1.0), tau, tau * tau, h};
-        if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
-        gs_real u = (gs_real)u_of(f, s) - u_c;
+        gs_real u = (gs_real)u_of(f, s);
+        if (!have_c) { u_c = u; have_c = true; }
+        u -= u_c;
         for (int k = 0; k < 4; k++) {
             ne.b[k] += w * x[k] * u;
             for (int m = 0; m < 4; m++) ne.A[k][m] += w * x[k] * x[m];
@@ -953,8 +952,9 @@ static bool pw_prepare(const gs_flight *f, uint32_t lo, uint32_t hi, int32_t t_l
         int32_t t = lt_of(f, s->t_us);
         gs_real tau = gs_time_span32_s((t - t_lo) - (t_hi - t)) / (ts + ts);
         gs_real x[3] = {GS_R(1.0), tau, tau * tau};
-        if (!have_c) { u_c = (gs_real)u_of(f, s); have_c = true; }
-        gs_real u = (gs_real)u_of(f, s) - u_c;
+        gs_real u = (gs_real)u_of(f, s);
+        if (!have_c) { u_c = u; have_c = true; }
+        u -= u_c;
         for (int k = 0; k < 3; k++) {
             P->b[k] += w * x[k] * u;
             for (int m = 0; m < 3; m++) P->A[k][m] += w * x[k] * x[m];
@@ -1301,6 +1301,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         f->up_y = -r->ay_px_s2 / r->a_px_s2;
     }
     uint32_t L = f->fl_first, R = f->fl_last;
+    int64_t c0 = t_at(f, L);  /* the COM's flight as grown begins (GS_T_NONE: no longer held) */
     /* the feet's times where the layout shows them: the flight is the feet's time off the floor */
     if (GS_WITH_POSE) {  /* (read only where a layout shows feet) */
         c->floor_off_px = c->floor_on_px = c->floor_before_px = NAN;
@@ -1311,7 +1312,7 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
     if (GS_WITH_POSE && FEET_ON(f) && falls) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
-        int64_t c0 = t_at(f, L), c1 = t_at(f, R);  /* the COM's flight as grown */
+        int64_t c1 = t_at(f, R);  /* ... and ends */
         bool known = apex_us != GS_T_NONE && c0 != GS_T_NONE;
         int64_t c0_from = known ? c0 - FEET_BEFORE_COM_US : 0;  /* the feet's events count from here */
         if (known && c1 != GS_T_NONE) {
@@ -1343,13 +1344,16 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
         float low_px = F1 != GS_LT_NONE && f->feet.stop_touch ? c->floor_on_px : gs_feet_low_px(&f->feet);
         c->fell = F0 != GS_LT_NONE ? low_px < c->floor_off_px - d_px - FALL_FLOOR_REL * size_px
                                : gs_feet_sank_since(&f->feet, c0);
+        /* ... or the landing met a floor well below the one that foot had rested on (size_px
+         * is the final judgement's gating size: the same standing size) */
+        c->fell = c->fell || (F1 != GS_LT_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * size_px);
     }
     /* a flight longer than the ring holds has lost its edges: no refinement. (The ring
      * holds a contiguous range; the contact samples lie between L and the newest and
      * are held, so L tells for all of them.) */
     bool feet = GS_WITH_POSE && c->F0_lus != GS_LT_NONE && c->F1_lus != GS_LT_NONE;
     if (GS_WITH_POSE) c->feet = feet;
-    bool refine = held(f, L) && !feet;  /* a body's are its feet's where seen */
+    bool refine = c0 != GS_T_NONE && !feet;  /* a body's are its feet's where seen */
     uint32_t lo, hi;  /* the outermost contact samples */
     int32_t T0 = c->T0_lus = boundary_time(f, c, -1, refine, &lo);
     int32_t T1 = c->T1_lus = boundary_time(f, c, +1, refine, &hi);
@@ -1484,7 +1488,7 @@ static uint8_t close_final(gs_flight *f, gs_close *c)
         bool sizeless_ok = !IS_RIGID(f) && feet;
         if (!finite_r(size) && sizeless_ok && !(warn & GS_WARN_DEPTH_CHANGED)) warn |= GS_WARN_NO_SIZE;
 
-        if ((GS_WITH_POSE && c->fell) || (F1 != GS_LT_NONE && c->floor_on_px < c->floor_before_px - FALL_FLOOR_REL * (float)gsize))
+        if (GS_WITH_POSE && c->fell)
             j->reason = GS_REJ_FALL;
         else if (GS_WITH_POSE && c->feet_contradict)
             j->reason = GS_REJ_NO_FEET_FLIGHT;
