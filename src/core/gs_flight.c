@@ -314,7 +314,8 @@ static NOINLINE float last_stand_size(const gs_flight *f);
 #define LT_NEWEST 0x8000000  /* the newest sample's local time: 2^27 */
 static void set_time_base(gs_flight *f)
 {
-    if (f->ring->t_last_us != GS_T_NONE) f->tb_us = f->ring->t_last_us - LT_NEWEST;
+    /* (before the first sample, GS_T_NONE: no sample to examine, the base goes unused) */
+    f->tb_us = (int64_t)((uint64_t)f->ring->t_last_us - LT_NEWEST);
 }
 
 /* a configured span in microseconds, false when it is not within [0, GS_FLIGHT_SPAN_MAX_US] */
@@ -1436,7 +1437,6 @@ static uint8_t close_final(gs_flight *f, gs_close *c)
     /* (a size is a median of finite sizes or NaN: a comparison with an unknown one is false) */
     gs_real size_se = NAN;
     gs_real size = IS_RIGID(f) ? rigid_size(f, in_lo, in_hi, &size_se) : stand_size(f, &size_se);
-    j->size_px = size;
     const gs_real size_measured = size;  /* (size itself is dropped where the depth changed) */
     uint32_t warn = 0;  /* j->warnings, set once */
 
@@ -1468,8 +1468,8 @@ static uint8_t close_final(gs_flight *f, gs_close *c)
             finite_r(c->floor_off_px) && GS_FABSR((gs_real)(c->floor_off_px - f->stand_floor_px)) > DEPTH_TOL_REL * size) {
             warn |= GS_WARN_DEPTH_CHANGED;
             size = size_se = NAN;
-            j->size_px = NAN;
         }
+        j->size_px = size;
         gs_real ra = fr.a_se_px_s2 / fr.a_px_s2;  /* the acceleration's relative SE */
         if (finite_r(size)) {
             height = size * q;
@@ -1768,8 +1768,7 @@ static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full
 {
     uint32_t k = frame_steps(f, lag_us, 1);
     if (k < 1) k = 1;
-    if (idx < idx_of(f, gs_ring_oldest(f->ring)) + k) return NAN;
-    gs_sample_full b_b;
+    gs_sample_full b_b;  /* (a sample before the oldest held, or before the first, is not held) */
 #ifndef __OPTIMIZE_SIZE__
     /* usable_at reading only what the test and the speed need */
     const gs_sample *rs = gs_ring_at(f->ring, ring_idx(f, idx - k));
