@@ -210,8 +210,7 @@ const char *gs_flight_state_name(gs_flight_state s)
 
 static NOINLINE void set_state(gs_flight *f, gs_flight_state to, int64_t t_us)
 {
-    if (f->state == to) return;
-    if (GS_WITH_TRACE && f->trace) {
+    if (GS_WITH_TRACE && f->trace && f->state != to) {
         gs_event ev;
         memset(&ev, 0, sizeof ev);
         ev.type = GS_EV_STATE;
@@ -329,7 +328,8 @@ static bool span_cfg_us(float s, int32_t *span_us)
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
-    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP || !gs_cfg_is_baked(cfg)) return GS_EINVAL;
+    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP) return GS_EINVAL;
+    /* (a baked build reads its baked configuration, never cfg: gs_pipeline_init refuses any other) */
     memset(f, 0, sizeof *f);  /* (GS_FS_IDLE, no frame interval, no feet, no close pending) */
     f->cfg = cfg;
     f->ring = ring;
@@ -370,7 +370,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
 void gs_flight_use_feet(gs_flight *f, float delta_rel, bool stop_touch)
 {
     if (!f) return;
-    f->feet_on = true;
+    if (GS_WITH_POINT) f->feet_on = true;  /* (without a point layout every object has feet: FEET_ON) */
     gs_feet_init(&f->feet, delta_rel, stop_touch);
 }
 
