@@ -180,7 +180,7 @@ typedef struct {
     uint32_t wait_alarm;       /* ... the contact alarm it landed with */
 #if GS_CLOSE_LAG_FRAMES > 0
     gs_close close;            /* the pending close: no sample is examined until it is done */
-    gs_fit_memo memo;          /* the last robust fit of the current decision (a close's spans frames) */
+    gs_fit_memo memo;          /* the last robust fit of the current decision (a close's may span frames) */
     bool close_whole;          /* every close runs whole in its landing's frame */
     gs_feet_frame feet_held[GS_CLOSE_LAG_FRAMES]; /* the feet of the frames since, oldest first */
     uint32_t feet_held_n;
