@@ -151,7 +151,9 @@ static float v_len(vec2 a) { return sqrtf(a.x * a.x + a.y * a.y); }
 static NOINLINE float acos_deg(float cs)
 {
     cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
-    return GS_ACOSF(cs) * RAD_TO_DEG;
+    /* gs_acosf's atan2 form without its range test: after the clamp only a NaN is out of range, and atan2 keeps it */
+    float rad = GS_REAL_IS_FLOAT ? gs_atan2f(sqrtf((1.0f - cs) * (1.0f + cs)), cs) : acosf(cs);
+    return rad * RAD_TO_DEG;
 }
 
 /* 0 at x0, 1 at x1 (either order), linear and clamped between. */
@@ -672,7 +674,7 @@ static void com_result(const frame *f, float total, gs_com_out *out)
     }
 #endif
     float frac = f->com.e / total;
-    float w = frac * frac * (n > 0 ? csum / (float)n : 0.0f);
+    float w = frac * frac * (csum / (float)n); /* n > 0: the trunk's corners include an observed one */
     /* a segment missing outright (not even rebuilt from its mirror, e.g. the head
      * out of the frame at the apex) biases the renormalised COM by centimetres:
      * such frames count only when nothing better exists */

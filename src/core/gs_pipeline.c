@@ -204,14 +204,14 @@ gs_status gs_pipeline_com(const gs_pipeline *p, const gs_kp *kp, gs_com_out *com
     return gs_com_compute(p->layout, c->mass_table, c->stature, c->min_conf, kp, com);
 }
 
-gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp, const gs_com_out *com)
+/* com's sample with weight w, and the feet from kp */
+static gs_status push_com(gs_pipeline *p, int64_t t_us, const gs_kp *kp, const gs_com_out *com, float w)
 {
-    if (!p || !kp || !com) return GS_EINVAL;
     gs_sample_full s;
     s.t_us = t_us;
     s.x_px = com->x_px;
     s.y_px = com->y_px;
-    s.w = gs_finite2_f(com->x_px, com->y_px) ? com->w : 0.0f;
+    s.w = w;
     s.size_px = com->stature_px;
     s.up_x = com->up_x;
     s.up_y = com->up_y;
@@ -233,12 +233,18 @@ gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp,
     return push_sample(p, &s, feet);
 }
 
+gs_status gs_pipeline_push_com_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp, const gs_com_out *com)
+{
+    if (!p || !kp || !com) return GS_EINVAL;
+    return push_com(p, t_us, kp, com, gs_finite2_f(com->x_px, com->y_px) ? com->w : 0.0f);
+}
+
 gs_status gs_pipeline_push_keypoints_us(gs_pipeline *p, int64_t t_us, const gs_kp *kp)
 {
     gs_com_out c;
     gs_status st = gs_pipeline_com(p, kp, &c);
     if (st != GS_OK) return st;
-    return gs_pipeline_push_com_us(p, t_us, kp, &c);
+    return push_com(p, t_us, kp, &c, c.w); /* (gs_com_compute's w is 0 where its COM is not finite) */
 }
 
 gs_status gs_pipeline_push_point_us(gs_pipeline *p, int64_t t_us, float x_px, float y_px,
