@@ -64,7 +64,8 @@ typedef struct {
 } gs_feet;
 
 /* delta_rel: the point's height above its rest when the foot leaves, as a fraction of
- * stature; stop_touch: see above. */
+ * stature; stop_touch: see above (a build with one skeleton layout, gs_features.h, has its
+ * touch only: by the stop without COCO-17, by the recrossing without BlazePose-33). */
 void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch);
 /* One frame: the two points' image positions x_px[i], y_px[i] (NaN missing), the up
  * direction (unit) and the body's size in px (stature; NaN unknown: the frame is skipped).
