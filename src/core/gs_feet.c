@@ -112,13 +112,15 @@ static int64_t crossing_time(const gs_feet *ft, const float *uk, const uint32_t 
 }
 
 /* The newest crossing of level L by the point within the history, rising (up) or falling,
- * interpolated; GS_T_NONE when none. */
-static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up)
+ * interpolated, to *t_us; false when none. */
+static bool crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up, int64_t *t_us)
 {
     float uk[GS_FEET_HIST];
     uint32_t ak[GS_FEET_HIST];
     unsigned n = known_heights(ft, f, uk, ak), i = crossing_at(uk, n, L, up);
-    return i < n ? crossing_time(ft, uk, ak, i, L) : GS_T_NONE;
+    if (i == n) return false;
+    *t_us = crossing_time(ft, uk, ak, i, L);
+    return true;
 }
 
 /* The newest downward crossing of level L by a point the floor stops there (a toe landing),
@@ -128,14 +130,14 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
  * of L, or braked harder than a foot in the air is, may already touch, or be a blurred mix
  * of both: from the last frame surely above them the point falls on to L from its speed
  * between that frame and the one before, accelerating as a body falls, and reaches L no
- * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
-static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
+ * later than the straight line down to the first frame at L would. To *t_us; false when none. */
+static bool landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px, int64_t *t_us)
 {
     float uk[GS_FEET_HIST];
     uint32_t ak[GS_FEET_HIST];
     unsigned n = known_heights(ft, f, uk, ak);
     unsigned c = crossing_at(uk, n, L, false);  /* the first frame at L after the newest crossing */
-    if (c == n) return GS_T_NONE;
+    if (c == n) return false;
     unsigned a = c;  /* the last frame surely in the air before it: clear of L, and not braked */
     for (unsigned i = c + 1; i < n; i++) {
         float u = uk[i];
@@ -149,7 +151,10 @@ static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float ma
         a = i;
         break;
     }
-    if (a == c) return crossing_time(ft, uk, ak, c, L);
+    if (a == c) {
+        *t_us = crossing_time(ft, uk, ak, c, L);
+        return true;
+    }
     float ua = uk[a];
     float ta = (float)ak[a] * 1e-6f, tc = (float)ak[c] * 1e-6f;  /* s before the newest */
     float tau = (ta - tc) * (ua - L) / (ua - uk[c]);  /* the chord's: the latest */
@@ -161,7 +166,8 @@ static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float ma
         float tq = disc >= 0.0f ? (sqrtf(disc) - v) / g : NAN;
         if (tq >= 0.0f && tq < tau) tau = tq;
     }
-    return ft->t_last_us - (int32_t)((ta - tau) * 1e6f + 0.5f);  /* (int32: no 64-bit conversion on the target) */
+    *t_us = ft->t_last_us - (int32_t)((ta - tau) * 1e6f + 0.5f);  /* (int32: no 64-bit conversion on the target) */
+    return true;
 }
 
 /* the median of the point's heights `back`, `back`+1 and `back`+2 frames before the newest
@@ -224,8 +230,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float lift_px = f->rest_px + d;  /* the lift level */
     bool above = u > lift_px + margin;
     if (f->armed && above && f->lift_pending) {
-        int64_t tc = crossing_us(ft, f, lift_px, true);
-        if (tc != GS_T_NONE) {
+        int64_t tc;
+        if (crossing_us(ft, f, lift_px, true, &tc)) {
             log_event(f->lift, tc, f->rest_px, NAN);
             f->lifted = 1;
             f->low_px = u;
@@ -241,8 +247,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (!(vf < v1)) vf = v1;
     if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
         (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
-        int64_t tc = landing_us(ft, f, u + d, margin, size_px);
-        if (tc != GS_T_NONE) {
+        int64_t tc;
+        if (landing_us(ft, f, u + d, margin, size_px, &tc)) {
             log_event(f->touch, tc, u, f->floor_px);
             f->touch_unsure = 1;
             f->lifted = 0;
@@ -251,8 +257,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* a touch by the recrossing (ankles): back down through the level it left, plus delta */
     float back_px = f->floor_px + d;  /* (the recrossing's level) */
     if (RECROSS && !stop_touch && f->lifted && u <= back_px) {
-        int64_t tc = crossing_us(ft, f, back_px, false);
-        if (tc != GS_T_NONE) {
+        int64_t tc;
+        if (crossing_us(ft, f, back_px, false, &tc)) {
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
             f->falling = 0;  /* the next frame tells */
