@@ -15,6 +15,7 @@
 #define MARGIN_REL  0.01f  /* a lift is confirmed this far above its crossing level (noise) */
 #define STOP_RATIO  3.0f   /* stopped: falling less than a third as fast as the frame before */
 #define REST_MIN_N  3u     /* ... and at least this many resting samples */
+#define REST_AVG_N  32u    /* the floor level follows its resting samples as their mean, then 1/(this + 1) of each */
 #define LAG_US      100000u /* stillness: the height against the frame about this far back */
 #define UP_COS_MIN  0.9998f /* cos 1.15 deg: a larger turn of up forgets the levels */
 #define RISE_REST_K 3       /* a floor higher than the last one must be rested on this many times longer
@@ -285,9 +286,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         f->rest_for_us = resting ? f->rest_for_us + (age_us(ft, 1)) : 0u;
     }
     if (resting) {
-        uint32_t k = f->rest_n < 32u ? f->rest_n : 32u;
-        f->rest_px += (m - f->rest_px) / (float)(k + 1u);
-        if (f->rest_n < 0xFFFFu) f->rest_n++;
+        f->rest_px += (m - f->rest_px) / (float)(f->rest_n + 1u);
+        if (f->rest_n < REST_AVG_N) f->rest_n++;
     }
     uint32_t need_us = f->rest_px > f->floor_px + d + GS_FEET_SINK_REL * size_px ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
     bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
