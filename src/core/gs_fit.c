@@ -1823,8 +1823,8 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
         return GS_EINVAL;
     }
     empty_result(out, GS_T_NONE, 0);
-    if (!ring || !keep || count == 0) {
-        return GS_EINVAL;
+    if (!ring || !keep) {
+        return GS_EINVAL; /* (an empty window is refused by win_open: fewer than 3 usable samples) */
     }
     st = win_open(&wn, ring, first, count);
     if (st == GS_OK) {
