@@ -37,7 +37,7 @@ typedef struct {
     uint32_t rest_for_us;      /* how long it has rested so far (0: not resting) */
     int64_t rested_from_us, rested_to_us; /* the latest run of frames on the floor (gs_feet_resting_at) */
     int64_t sank_us;           /* the latest frame it was well below the floor it had rested on, GS_T_NONE none */
-    uint16_t rest_n;           /* samples averaged into rest_px */
+    uint16_t rest_n;           /* samples averaged into rest_px (counted up to 32) */
     uint8_t armed;             /* rested long enough, at or near its level: a rise is a lift */
     uint8_t lift_pending;      /* armed and above its lift level last frame: a lift if this one is too */
     uint8_t lifted;            /* lifted and not back yet (for the recrossing touch) */
@@ -64,7 +64,8 @@ typedef struct {
 } gs_feet;
 
 /* delta_rel: the point's height above its rest when the foot leaves, as a fraction of
- * stature; stop_touch: see above. */
+ * stature; stop_touch: see above (a build with one skeleton layout, gs_features.h, has its
+ * touch only: by the stop without COCO-17, by the recrossing without BlazePose-33). */
 void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch);
 /* One frame: the two points' image positions x_px[i], y_px[i] (NaN missing), the up
  * direction (unit) and the body's size in px (stature; NaN unknown: the frame is skipped).

@@ -15,12 +15,15 @@
 #define MARGIN_REL  0.01f  /* a lift is confirmed this far above its crossing level (noise) */
 #define STOP_RATIO  3.0f   /* stopped: falling less than a third as fast as the frame before */
 #define REST_MIN_N  3u     /* ... and at least this many resting samples */
+#define REST_AVG_N  32u    /* the floor level follows its resting samples as their mean, then 1/(this + 1) of each */
 #define LAG_US      100000u /* stillness: the height against the frame about this far back */
 #define UP_COS_MIN  0.9998f /* cos 1.15 deg: a larger turn of up forgets the levels */
 #define RISE_REST_K 3       /* a floor higher than the last one must be rested on this many times longer
                              * (stepping onto a box takes long; a foot at its apex in the air is still briefly) */
 /* the touch by recrossing serves ankles (COCO-17) only: a build without that layout has none */
 #define RECROSS GS_WITH_COCO17  /* (touch_unsure is 2 after a recrossing only) */
+/* ... and the touch by the stop toes (BlazePose-33): a build with only one of the layouts has only its touch */
+#define STOPS (!RECROSS || GS_WITH_BLAZEPOSE33)
 #define NOISE_K     3.0f   /* margins at least this many of the point's own jitter */
 #define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
 #define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
@@ -47,7 +50,7 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
     memset(ft, 0, sizeof *ft);
     ft->up_y = -1.0f;
     ft->delta_rel = delta_rel;
-    ft->stop_touch = stop_touch;
+    ft->stop_touch = !RECROSS || (STOPS && stop_touch);
     ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         reset_track(&ft->pt[p]);
@@ -77,25 +80,48 @@ static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(
 /* the point's height `back` frames before the newest (inline: one load at a fixed slot, shorter than a call) */
 static inline float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
 
-/* The newest crossing of level L by the point within the history, rising (up) or falling,
- * interpolated between the two frames around it; GS_T_NONE when none. */
-static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up)
+/* The point's known heights in the history, newest first (a missing or outlier frame is
+ * bridged), and their ages in us: their count. */
+static NOINLINE unsigned known_heights(const gs_feet *ft, const gs_foot *f, float uk[GS_FEET_HIST],
+                                       uint32_t ak[GS_FEET_HIST])
 {
-    uint32_t newer = UINT32_MAX;  /* the newer frame of the pair: a missing or outlier frame is bridged */
+    unsigned n = 0;
     for (uint32_t b = 0; b < held(ft); b++) {
-        float u0 = u_at(f, b);
-        if (!fin(u0)) continue;
-        if (newer != UINT32_MAX) {
-            float u1 = u_at(f, newer);
-            if ((u0 <= L) == up && (u1 <= L) != up) {  /* (both finite) */
-                uint32_t a0 = age_us(ft, b), a1 = age_us(ft, newer);
-                float w = (L - u0) / (u1 - u0);
-                return ft->t_last_us - (int64_t)a0 + (int32_t)(w * (float)(a0 - a1) + 0.5f);
-            }
+        float u = u_at(f, b);
+        if (fin(u)) {
+            uk[n] = u;
+            ak[n++] = age_us(ft, b);
         }
-        newer = b;
     }
-    return GS_T_NONE;
+    return n;
+}
+
+/* The newest crossing of level L among the n known heights, rising (up) or falling: the
+ * index i of the frame after it (uk[i + 1] the one before), n when none. */
+static unsigned crossing_at(const float *uk, unsigned n, float L, bool up)
+{
+    for (unsigned i = 0; i + 1u < n; i++)
+        if ((uk[i + 1u] <= L) == up && (uk[i] <= L) != up) return i;
+    return n;
+}
+
+/* The instant of that crossing, interpolated between the two frames around it. */
+static int64_t crossing_time(const gs_feet *ft, const float *uk, const uint32_t *ak, unsigned i, float L)
+{
+    float w = (L - uk[i + 1u]) / (uk[i] - uk[i + 1u]);
+    return ft->t_last_us - (int64_t)ak[i + 1u] + (int32_t)(w * (float)(ak[i + 1u] - ak[i]) + 0.5f);
+}
+
+/* The newest crossing of level L by the point within the history, rising (up) or falling,
+ * interpolated, to *t_us; false when none. */
+static bool crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up, int64_t *t_us)
+{
+    float uk[GS_FEET_HIST];
+    uint32_t ak[GS_FEET_HIST];
+    unsigned n = known_heights(ft, f, uk, ak), i = crossing_at(uk, n, L, up);
+    if (i == n) return false;
+    *t_us = crossing_time(ft, uk, ak, i, L);
+    return true;
 }
 
 /* The newest downward crossing of level L by a point the floor stops there (a toe landing),
@@ -105,23 +131,14 @@ static int64_t crossing_us(const gs_feet *ft, const gs_foot *f, float L, bool up
  * of L, or braked harder than a foot in the air is, may already touch, or be a blurred mix
  * of both: from the last frame surely above them the point falls on to L from its speed
  * between that frame and the one before, accelerating as a body falls, and reaches L no
- * later than the straight line down to the first frame at L would. GS_T_NONE when none. */
-static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px)
+ * later than the straight line down to the first frame at L would. To *t_us; false when none. */
+static bool landing_us(const gs_feet *ft, const gs_foot *f, float L, float margin, float size_px, int64_t *t_us)
 {
-    float uk[GS_FEET_HIST];     /* finite heights, newest first (a missing or outlier frame is bridged) */
-    uint32_t ak[GS_FEET_HIST];  /* their ages, us */
-    unsigned n = 0;
-    for (uint32_t b = 0; b < held(ft); b++) {
-        float u = u_at(f, b);
-        if (fin(u)) {
-            uk[n] = u;
-            ak[n++] = age_us(ft, b);
-        }
-    }
-    unsigned c = n;  /* the first frame at L after the newest crossing */
-    for (unsigned i = 0; i + 1 < n && c == n; i++)
-        if (uk[i + 1] > L && uk[i] <= L) c = i;
-    if (c == n) return GS_T_NONE;
+    float uk[GS_FEET_HIST];
+    uint32_t ak[GS_FEET_HIST];
+    unsigned n = known_heights(ft, f, uk, ak);
+    unsigned c = crossing_at(uk, n, L, false);  /* the first frame at L after the newest crossing */
+    if (c == n) return false;
     unsigned a = c;  /* the last frame surely in the air before it: clear of L, and not braked */
     for (unsigned i = c + 1; i < n; i++) {
         float u = uk[i];
@@ -135,7 +152,10 @@ static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float ma
         a = i;
         break;
     }
-    if (a == c) return crossing_us(ft, f, L, false);
+    if (a == c) {
+        *t_us = crossing_time(ft, uk, ak, c, L);
+        return true;
+    }
     float ua = uk[a];
     float ta = (float)ak[a] * 1e-6f, tc = (float)ak[c] * 1e-6f;  /* s before the newest */
     float tau = (ta - tc) * (ua - L) / (ua - uk[c]);  /* the chord's: the latest */
@@ -147,7 +167,8 @@ static int64_t landing_us(const gs_feet *ft, const gs_foot *f, float L, float ma
         float tq = disc >= 0.0f ? (sqrtf(disc) - v) / g : NAN;
         if (tq >= 0.0f && tq < tau) tau = tq;
     }
-    return ft->t_last_us - (int32_t)((ta - tau) * 1e6f + 0.5f);  /* (int32: no 64-bit conversion on the target) */
+    *t_us = ft->t_last_us - (int32_t)((ta - tau) * 1e6f + 0.5f);  /* (int32: no 64-bit conversion on the target) */
+    return true;
 }
 
 /* the median of the point's heights `back`, `back`+1 and `back`+2 frames before the newest
@@ -186,7 +207,7 @@ static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
 static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float size_px)
 {
     float d = ft->delta_rel * size_px;
-    bool stop_touch = !RECROSS || ft->stop_touch;
+    bool stop_touch = !RECROSS || (STOPS && ft->stop_touch);  /* (ft->stop_touch, folded where the build has one touch) */
     if (!fin(u)) return;  /* a missing frame changes nothing */
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);  /* (nothing below changes the history) */
     /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */
@@ -210,8 +231,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     float lift_px = f->rest_px + d;  /* the lift level */
     bool above = u > lift_px + margin;
     if (f->armed && above && f->lift_pending) {
-        int64_t tc = crossing_us(ft, f, lift_px, true);
-        if (tc != GS_T_NONE) {
+        int64_t tc;
+        if (crossing_us(ft, f, lift_px, true, &tc)) {
             log_event(f->lift, tc, f->rest_px, NAN);
             f->lifted = 1;
             f->low_px = u;
@@ -227,8 +248,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (!(vf < v1)) vf = v1;
     if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
         (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
-        int64_t tc = landing_us(ft, f, u + d, margin, size_px);
-        if (tc != GS_T_NONE) {
+        int64_t tc;
+        if (landing_us(ft, f, u + d, margin, size_px, &tc)) {
             log_event(f->touch, tc, u, f->floor_px);
             f->touch_unsure = 1;
             f->lifted = 0;
@@ -237,8 +258,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* a touch by the recrossing (ankles): back down through the level it left, plus delta */
     float back_px = f->floor_px + d;  /* (the recrossing's level) */
     if (RECROSS && !stop_touch && f->lifted && u <= back_px) {
-        int64_t tc = crossing_us(ft, f, back_px, false);
-        if (tc != GS_T_NONE) {
+        int64_t tc;
+        if (crossing_us(ft, f, back_px, false, &tc)) {
             log_event(f->touch, tc, f->floor_px, f->floor_px);
             f->touch_unsure = 2;
             f->falling = 0;  /* the next frame tells */
@@ -265,9 +286,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         f->rest_for_us = resting ? f->rest_for_us + (age_us(ft, 1)) : 0u;
     }
     if (resting) {
-        uint32_t k = f->rest_n < 32u ? f->rest_n : 32u;
-        f->rest_px += (m - f->rest_px) / (float)(k + 1u);
-        if (f->rest_n < 0xFFFFu) f->rest_n++;
+        f->rest_px += (m - f->rest_px) / (float)(f->rest_n + 1u);
+        if (f->rest_n < REST_AVG_N) f->rest_n++;
     }
     uint32_t need_us = f->rest_px > f->floor_px + d + GS_FEET_SINK_REL * size_px ? RISE_REST_K * GS_FEET_REST_US : GS_FEET_REST_US;
     bool rested = resting && f->rest_n >= REST_MIN_N && f->rest_for_us >= need_us;
@@ -289,15 +309,16 @@ static void process_pending(gs_feet *ft, const float *next)
 {
     unsigned s = WAIT_SLOTS - 1u;  /* the pending frame's */
     float size = ft->pend_size_px, spike = SPIKE_REL * size;
-    for (int p = 0; p < GS_FEET_POINTS && next && ft->n > 0; p++) {
+    for (int p = 0; next && ft->n > 0 && p < GS_FEET_POINTS; p++) {
         float a = u_at(&ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
-        if ((b - a > spike && b - c > spike) || (a - b > spike && c - b > spike)) ft->pt[p].u_px[s] = NAN;
+        float da = b - a, dc = b - c;  /* (a - b is -(b - a) exactly) */
+        if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
     }
     ft->n++;
-    for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) {  /* the history one slot older */
-        ft->t_us[k] = ft->t_us[k - 1u];
-        for (int p = 0; p < GS_FEET_POINTS; p++) ft->pt[p].u_px[k] = ft->pt[p].u_px[k - 1u];
-    }
+    /* the history one slot older */
+    for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->t_us[k] = ft->t_us[k - 1u];
+    for (int p = 0; p < GS_FEET_POINTS; p++)
+        for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->pt[p].u_px[k] = ft->pt[p].u_px[k - 1u];
     ft->t_prev_us = ft->t_last_us;
     ft->t_last_us = ft->pend_t_us;
     for (int p = 0; p < GS_FEET_POINTS; p++) {

@@ -152,9 +152,20 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
     f->n++;
 }
 
+/* a, b and c all finite (where the build optimises for size one test, as gs_finite2_f:
+ * (a - a) + (b - b) + (c - c) is 0 exactly then, NaN otherwise) */
+static bool finite3_r(gs_real a, gs_real b, gs_real c)
+{
+#ifdef __OPTIMIZE_SIZE__
+    return (a - a) + (b - b) + (c - c) == GS_R(0.0);
+#else
+    return gs_finite_r(a) && gs_finite_r(b) && gs_finite_r(c);
+#endif
+}
+
 void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
 {
-    if (!f || !(w > GS_R(0.0)) || !gs_finite_r(w) || !gs_time_ok(t_us) || !gs_finite_r(x_px) || !gs_finite_r(y_px)) {
+    if (!f || !(w > GS_R(0.0)) || !finite3_r(w, x_px, y_px) || !gs_time_ok(t_us)) {
         return;
     }
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
@@ -204,8 +215,9 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
     for (k = 0; k < 3; rk += 3 - k, k++) {
+        /* (an infinite diagonal makes its column's norm infinite or NaN: refused too) */
         gs_real d = fabs(*rk);
-        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !gs_finite_r(d)) {
+        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k])) {
             return GS_EINVAL;
         }
     }
@@ -261,7 +273,7 @@ static gs_status solve_par_only(const gs_fit *f, gs_par *p, const gs_par *base)
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
     for (k = 0; k < 3; rk += 3 - k, k++) {
         gs_real d = fabs(*rk);
-        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k]) || !isfinite(d)) {
+        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k])) {
             return GS_EINVAL;
         }
     }
@@ -469,15 +481,13 @@ static gs_real resid_norm(const gs_par *p, const gs_fsamp *s)
     return sqrt(resid2(p, s));
 }
 
-/* The parabola through three samples (Newton divided differences); false when two times coincide. */
-static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
+/* The parabola through three samples (Newton divided differences). Two at one time
+ * divide by zero: c2 of each axis is then infinite or NaN (par_finite). */
+static void par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c, gs_par *p)
 {
     gs_real ta = a->tau, tb = b->tau, tc = c->tau;
     gs_real dab = tb - ta, dac = tc - ta, dbc = tc - tb;
-    int axis, k;
-    if (dab == GS_R(0.0) || dac == GS_R(0.0) || dbc == GS_R(0.0)) {
-        return false;
-    }
+    int axis;
 #if GS_FIT_FAST && defined(__GNUC__)
     if (!GS_REAL_IS_FLOAT) {
         /* fast double builds: both axes side by side, the same operations */
@@ -486,10 +496,9 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
         gs_v2d c2 = (sac - sab) / (gs_v2d){dbc, dbc};
         gs_v2d c1 = sab - c2 * (gs_v2d){ta + tb, ta + tb};
         gs_v2d c0 = va - (gs_v2d){ta, ta} * (c1 + c2 * (gs_v2d){ta, ta});
-        gs_v2d fin = (c0 - c0) + (c1 - c1) + (c2 - c2); /* x - x is 0 exactly when x is finite */
         p->c[0] = c0[0], p->c[1] = c1[0], p->c[2] = c2[0];
         p->c[3] = c0[1], p->c[4] = c1[1], p->c[5] = c2[1];
-        return fin[0] == 0.0 && fin[1] == 0.0;
+        return;
     }
 #endif
     for (axis = 0; axis < 2; axis++) {
@@ -505,6 +514,12 @@ static bool par_through(const gs_fsamp *a, const gs_fsamp *b, const gs_fsamp *c,
         p->c[3 * axis + 1] = c1;
         p->c[3 * axis + 2] = c2;
     }
+}
+
+/* Every coefficient of p finite: a curve, not a degenerate triple's. */
+static bool par_finite(const gs_par *p)
+{
+    int k;
     for (k = 0; k < 6; k++) {
         if (!gs_finite_r(p->c[k])) {
             return false;
@@ -825,15 +840,12 @@ GS_AVX2 static double tukey_loss_avx2(const gs_win *wn, const gs_par *p, double 
  * keys sharing a prefix go to the buffer for select_key; while more than
  * GS_FIT_CACHE share it (long windows), a counting pass over the samples (no
  * storage) narrows it by 4 bits. The cached samples' residuals are kept for the
- * reweighting that follows. */
+ * reweighting that follows. An open window has m >= 3 usable samples (win_open). */
 static gs_real median_resid(const gs_win *wn, const gs_par *p)
 {
     uint32_t prefix = 0, mask = 0, k, i, left = wn->m;
     int shift = 32;
     float v;
-    if (left == 0) {
-        return (gs_real)NAN;
-    }
 #if GS_FIT_FAST
     if (wn->count <= GS_FIT_CACHE) {
         /* every usable sample cached: one pass collects all keys (no prefix yet) */
@@ -1393,7 +1405,7 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
 }
 
 /* The k-th usable sample (win_at, unpacked into *buf); count must cover it. */
-static const gs_fsamp *usable_at(const gs_win *wn, uint32_t k, gs_fsamp *buf)
+static NOINLINE const gs_fsamp *usable_at(const gs_win *wn, uint32_t k, gs_fsamp *buf)
 {
     uint32_t i;
     if (wn->m == wn->count) {
@@ -1411,15 +1423,18 @@ static const gs_fsamp *usable_at(const gs_win *wn, uint32_t k, gs_fsamp *buf)
     return win_at(wn, wn->count - 1, buf);
 }
 
-/* The parabola through the ka-th, kb-th and kc-th usable samples (par_through). */
-static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint32_t kc, gs_par *p)
+/* The parabola through the usable samples of ranks k[0], k[1] and k[2] (par_through). */
+static void par_through_usable(const gs_win *wn, const uint32_t k[3], gs_par *p)
 {
-    gs_fsamp a, b, c;
-    if (GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE) {
-        return par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], p); /* every sample usable, cached */
+    gs_fsamp buf[3];
+    const gs_fsamp *s[3];
+    int j;
+    for (j = 0; j < 3; j++) {
+        /* every sample usable and cached: no scan (else the window was checked to be held) */
+        s[j] = GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE ? &wn->cache[k[j]]
+                                                                             : usable_at(wn, k[j], &buf[j]);
     }
-    /* the window was checked to be held, and usable_at finds usable samples */
-    return par_through(usable_at(wn, ka, &a), usable_at(wn, kb, &b), usable_at(wn, kc, &c), p);
+    par_through(s[0], s[1], s[2], p);
 }
 
 /* Least-median-of-squares start: of up to GS_FIT_TRIPLES triples, one sample
@@ -1429,7 +1444,7 @@ static bool par_through_usable(const gs_win *wn, uint32_t ka, uint32_t kb, uint3
 static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *best_med)
 {
     uint32_t state = GS_FIT_SEED_IRLS;
-    uint32_t third = m / 3, k;
+    uint32_t third = m / 3, k, j;
     bool found = false;
 #if GS_FIT_FAST
     double best_T = 0.0; /* below_key of *best_med's squared residual as a float, once found */
@@ -1448,33 +1463,37 @@ static bool lmeds_start(const gs_win *wn, uint32_t m, gs_par *best, gs_real *bes
     bool all_cached = GS_FIT_FAST && wn->m == wn->count && wn->count <= GS_FIT_CACHE;
 #if GS_FIT_LMS_TABLE
     uint64_t magic_ab = UINT64_MAX / third + 1u, magic_c = UINT64_MAX / (m - 2 * third) + 1u;
-    (void)state;
+    (void)state, (void)j;
 #endif
     *best_med = (gs_real)INFINITY;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
-#if GS_FIT_LMS_TABLE
-        uint32_t ka = mod_by(lms_draws[3u * k], magic_ab, third);
-        uint32_t kb = third + mod_by(lms_draws[3u * k + 1u], magic_ab, third);
-        uint32_t kc = 2 * third + mod_by(lms_draws[3u * k + 2u], magic_c, m - 2 * third);
-#else
-        uint32_t ka = rand_below(&state, third);
-        uint32_t kb = third + rand_below(&state, third);
-        uint32_t kc = 2 * third + rand_below(&state, m - 2 * third);
-#endif
+        uint32_t kt[3]; /* the ranks of the triple's samples, one from each third */
         gs_par p;
         gs_real med;
+#if GS_FIT_LMS_TABLE
+        kt[0] = mod_by(lms_draws[3u * k], magic_ab, third);
+        kt[1] = third + mod_by(lms_draws[3u * k + 1u], magic_ab, third);
+        kt[2] = 2 * third + mod_by(lms_draws[3u * k + 2u], magic_c, m - 2 * third);
+#else
+        for (j = 0; j < 3; j++) {
+            kt[j] = j * third + rand_below(&state, j < 2 ? third : m - 2 * third);
+        }
+#endif
 #if GS_FIT_FAST
         if (dedup) {
-            uint32_t t = (ka * third + (kb - third)) * span_c + (kc - 2 * third);
+            uint32_t t = (kt[0] * third + (kt[1] - third)) * span_c + (kt[2] - 2 * third);
             if (seen[t >> 5] & (1u << (t & 31u))) {
                 continue;
             }
             seen[t >> 5] |= 1u << (t & 31u);
         }
 #endif
-        if (!(all_cached ? par_through(&wn->cache[ka], &wn->cache[kb], &wn->cache[kc], &p)
-                         : par_through_usable(wn, ka, kb, kc, &p))) {
-            continue;
+        /* (a degenerate triple's curve leaves every usable sample's residual infinite or NaN:
+         * so is its median, which is never below the best) */
+        if (all_cached) {
+            par_through(&wn->cache[kt[0]], &wn->cache[kt[1]], &wn->cache[kt[2]], &p);
+        } else {
+            par_through_usable(wn, kt, &p);
         }
 #if GS_FIT_FAST
         if (found && (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE ? !median_below_cached(wn, &p, best_T)
@@ -1542,7 +1561,7 @@ static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_
             return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
         }
 #else
-        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, wn->r2);
+        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, NULL);
         if (st != GS_OK) {
             return st;
         }
@@ -1617,9 +1636,6 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     int k;
     have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
     have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out, NULL) == GS_OK;
-    if (!have[LMS] && !have[PLAIN]) {
-        return GS_EINVAL;
-    }
     /* a fast build keeps the plain run's flags and result (a few words for windows the cache holds) */
     uint32_t plain_keep[GS_FIT_FAST ? GS_FIT_CACHE / 32u : 1u];
     gs_fit_result plain_out;
@@ -1638,8 +1654,9 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
             }
         }
     }
+    /* (a run's loss is finite: each of at most count terms is at most its weight, <= 1) */
     if (!(loss[PLAIN] <= loss[LMS])) {
-        return loss[LMS] < (gs_real)INFINITY ? GS_OK : GS_EINVAL;
+        return GS_OK; /* the LMS run won */
     }
     if (!(loss[PLAIN] < (gs_real)INFINITY)) {
         return GS_EINVAL; /* neither start gave a fit */
@@ -1665,16 +1682,18 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
     gs_par best;
     bool found = false;
     for (k = 0; k < GS_FIT_TRIPLES; k++) {
-        uint32_t ka = rand_below(&state, m);
-        uint32_t kb = rand_below(&state, m);
-        uint32_t kc = rand_below(&state, m);
+        uint32_t kt[3], j;
         gs_par p;
         uint32_t n_in = 0;
         gs_real cost = GS_R(0.0);
-        if (ka == kb || ka == kc || kb == kc) {
+        for (j = 0; j < 3; j++) {
+            kt[j] = rand_below(&state, m);
+        }
+        if (kt[0] == kt[1] || kt[0] == kt[2] || kt[1] == kt[2]) {
             continue;
         }
-        if (!par_through_usable(wn, ka, kb, kc, &p)) {
+        par_through_usable(wn, kt, &p);
+        if (!par_finite(&p)) {
             continue;
         }
         for (i = 0; i < wn->count; i++) {
@@ -1776,10 +1795,10 @@ static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_sc
 gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_fit_method method,
                         float min_scale_px, uint32_t *keep, gs_fit_result *out)
 {
-    gs_fsamp cache[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
-    gs_real r2[GS_FIT_FAST ? GS_FIT_CACHE : 1u];
-    uint32_t key[GS_FIT_FAST ? 2u * GS_FIT_CACHE : 1u]; /* the keys, and select_near's few */
 #if GS_FIT_FAST
+    gs_fsamp cache[GS_FIT_CACHE];
+    gs_real r2[GS_FIT_CACHE];
+    uint32_t key[2u * GS_FIT_CACHE]; /* the keys, and select_near's few */
     float med_key = 0.0f;
     uint32_t med_at = 0;
     gs_real soa[GS_REAL_IS_FLOAT ? 1u : 4u * GS_FIT_CACHE];
@@ -1789,10 +1808,11 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     gs_win wn;
     uint32_t i;
     gs_status st;
+#if GS_FIT_FAST
+    /* (the compact code reads none of the buffers) */
     wn.cache = cache;
     wn.r2 = r2;
     wn.key = key;
-#if GS_FIT_FAST
     wn.med_key = &med_key;
     wn.med_at = &med_at;
     wn.soa = soa;
@@ -1803,8 +1823,8 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
         return GS_EINVAL;
     }
     empty_result(out, GS_T_NONE, 0);
-    if (!ring || !keep || count == 0) {
-        return GS_EINVAL;
+    if (!ring || !keep) {
+        return GS_EINVAL; /* (an empty window is refused by win_open: fewer than 3 usable samples) */
     }
     st = win_open(&wn, ring, first, count);
     if (st == GS_OK) {
