@@ -20,7 +20,7 @@ typedef struct {
     uint32_t capacity;   /* power of two */
     uint32_t mask;
     uint64_t head;       /* absolute index of the next sample to write */
-    uint64_t valid_from; /* samples before this index fell out of the time span */
+    uint64_t valid_from; /* the oldest held: samples before it were overwritten or fell out of the time span */
     int64_t t_last_us;   /* newest sample's time, GS_T_NONE before the first */
     float last_up_x, last_up_y;  /* newest sample's body axis (not kept per sample) */
 } gs_ring;
@@ -60,11 +60,7 @@ float gs_sample_w(const gs_sample *s);
 /* Absolute index of the oldest sample still held (== head when empty). */
 GS_RING_FN uint64_t gs_ring_oldest(const gs_ring *r)
 {
-    if (!r) {
-        return 0;
-    }
-    uint64_t o = r->head > r->capacity ? r->head - r->capacity : 0;
-    return r->valid_from > o ? r->valid_from : o;
+    return r ? r->valid_from : 0;
 }
 
 GS_RING_FN uint64_t gs_ring_head(const gs_ring *r)

@@ -19,13 +19,14 @@
 #define MAD_TO_SIGMA GS_R(1.4826) /* 1 / Phi^-1(0.75) */
 #define MEDIAN_SE_FACTOR GS_R(1.2533) /* sqrt(pi/2): SE(median) / SE(mean), large n, normal data */
 
-/* Small-sample correction of the MAD (Croux & Rousseeuw 1992), n = 2..9;
- * n / (n - 0.8) beyond. Values from memory of their table. */
-static const gs_real k_mad_corr[10] = { 0, 0, 1.196, 1.495, 1.363, 1.206, 1.200, 1.140, 1.129, 1.107 };
+/* Small-sample correction of the MAD (Croux & Rousseeuw 1992), n = 2..9 from
+ * k_mad_corr[0]; n / (n - 0.8) beyond. Values from memory of their table. */
+static const gs_real k_mad_corr[8] = { 1.196, 1.495, 1.363, 1.206, 1.200, 1.140, 1.129, 1.107 };
 
-/* SE(median) / (sigma / sqrt(n)) for normal data and small n: the median of 2
- * is the mean; exact small-n ratios up to 5, the large-n value beyond. */
-static const gs_real k_median_se[6] = { 1.0, 1.0, 1.0, 1.160, 1.092, 1.197 };
+/* SE(median) / (sigma / sqrt(n)) for normal data and small n, n = 2..5 from
+ * k_median_se[0]: the median of 2 is the mean; exact small-n ratios up to 5, the
+ * large-n value beyond. */
+static const gs_real k_median_se[4] = { 1.0, 1.160, 1.092, 1.197 };
 
 /* Student-t 97.5 % quantiles by degrees of freedom (whole numbers: a byte each). */
 static const uint8_t k_t975_dof[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 15, 20, 30, 40, 60, 120};
@@ -188,7 +189,7 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
 #else
         gs_real mad = median_abs_dev_sorted(v, n, med, dev);
 #endif
-        gs_real corr = n < 10 ? k_mad_corr[n] : (gs_real)n / ((gs_real)n - GS_R(0.8));
+        gs_real corr = n < 10 ? k_mad_corr[n - 2u] : (gs_real)n / ((gs_real)n - GS_R(0.8));
         gs_real spread = MAD_TO_SIGMA * mad * corr;
         /* The fits' SEs are a floor: the spread of a few flights can be small by chance. */
         gs_real sigma = spread > se_floor ? spread : se_floor;
@@ -200,7 +201,7 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
             gs_real s4 = sigma * sigma * sigma * sigma;
             q = t975((gs_real)(n - 1u) * s4 / (excess2 * excess2));
         }
-        gs_real k = n < 6 ? k_median_se[n] : MEDIAN_SE_FACTOR;
+        gs_real k = n < 6 ? k_median_se[n - 2u] : MEDIAN_SE_FACTOR;
         half = q * k * sigma / GS_SQRT((gs_real)n);
     }
     if (gs_finite_r(half)) {

@@ -269,18 +269,19 @@ _Static_assert(sizeof k_nmea_fields / sizeof k_nmea_fields[0] == N_END, "the N_*
 
 /* a sentence: $GS, the tag, then fields [first, end); trace events have none */
 static const struct {
-    char tag[4];
+    char tag[3]; /* no NUL: written as its 3 bytes */
     uint8_t first, end;
 } k_nmea_lines[] = {
-    {"STA", N_START, N_JUMP},          {"JMP", N_JUMP, N_HEIGHT},     {"HGT", N_HEIGHT, N_HEIGHT_END},
-    {"SUM", N_HEIGHT, N_HEIGHT_END + 1}, {"SES", N_SESSION, N_WARNING}, {"WRN", N_WARNING, N_END},
+    {{'S', 'T', 'A'}, N_START, N_JUMP},          {{'J', 'M', 'P'}, N_JUMP, N_HEIGHT},
+    {{'H', 'G', 'T'}, N_HEIGHT, N_HEIGHT_END},   {{'S', 'U', 'M'}, N_HEIGHT, N_HEIGHT_END + 1},
+    {{'S', 'E', 'S'}, N_SESSION, N_WARNING},     {{'W', 'R', 'N'}, N_WARNING, N_END},
 };
 
 size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
 {
-    bool known = ev != NULL && (unsigned)ev->type < sizeof k_nmea_lines / sizeof k_nmea_lines[0];
-    gs_w w = {buf, cap, 0, buf != NULL && known};
-    if (!w.ok) return w_finish(&w);
+    gs_w w = {buf, cap, 0, false};
+    if (!buf || !ev || (unsigned)ev->type >= sizeof k_nmea_lines / sizeof k_nmea_lines[0]) return w_finish(&w);
+    w.ok = true;
     /* read once: the line's bytes may alias the event */
     unsigned type = (unsigned)ev->type, end = k_nmea_lines[type].end;
     w_raw(&w, "$GS", 3);

@@ -527,12 +527,10 @@ static size_t fmt_dec(char *buf, size_t cap, uint64_t mant, int e2, int p10, boo
     if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
     int nr = 0;
-    if (mant) {
-        gs_dec d;
-        dec_expand(mant, e2, p10, &d);
-        int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
-        if (count >= 0) nr = count + dec_round(&d, count, dig);
-    }
+    gs_dec d; /* mant 0: no digits, so every place written is a 0 */
+    dec_expand(mant, e2, p10, &d);
+    int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
+    if (count >= 0) nr = count + dec_round(&d, count, dig);
     char t[48];
     size_t n = put_digits(t, nr && neg, dig, nr, nr - decimals, decimals);
     return put_out(buf, cap, t, n);
@@ -561,7 +559,17 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
     /* |v| = mant * 2^e2 from the IEEE bits, as dbits_mant */
     uint32_t be = mag >> 23, mant = mag & 0x7FFFFFu;
     if (be) mant |= 0x800000u;
-    return fmt_dec(buf, cap, mant, be ? (int)be - 150 : -149, 0, (bits >> 31) != 0u, decimals);
+    int e2 = be ? (int)be - 150 : -149;
+    /* The rounding reads the digits down to 10^-(decimals + 1) and no further: below 2^24
+     * those of floor(|v| 10^(decimals + 1)) = mant 10^(decimals + 1) >> -e2 (< 2^58), an
+     * integer with decimals + 1 decimals; above, |v| = mant << e2 < 2^50 is an integer.
+     * 64-bit integers, bit by bit: no big integer, no variable 64-bit shift. */
+    uint64_t n = mant;
+    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_dec refuses */
+    for (int k = 0; k < p; k++) n *= 10u;
+    for (; e2 > 0; e2--) n <<= 1;
+    for (; e2 < 0 && n; e2++) n >>= 1;
+    return fmt_dec(buf, cap, n, 0, p, (bits >> 31) != 0u, decimals);
 }
 
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)

@@ -112,7 +112,7 @@ void gs_ring_store(gs_ring *r, const gs_sample_full *s)
         } else {
             /* ages are exact below 2^32 us: drop the samples that reached the span */
             uint32_t lo = (uint32_t)(uint64_t)t;
-            uint64_t oldest = gs_ring_oldest(r);
+            uint64_t oldest = r->valid_from;
             while (oldest < r->head &&
                    (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
                 oldest++;
@@ -120,6 +120,8 @@ void gs_ring_store(gs_ring *r, const gs_sample_full *s)
             r->valid_from = oldest;
         }
     }
+    /* a full ring overwrites its oldest sample: the capacity newest stay held */
+    if (r->head - r->valid_from >= r->capacity) r->valid_from = r->head - r->capacity + 1u;
     gs_sample *d = &r->buf[(uint32_t)(r->head & r->mask)];
     d->t_us = (uint32_t)(uint64_t)t;  /* modulo 2^32: read back relative to the newest */
     d->x_px = s->x_px;

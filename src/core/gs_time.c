@@ -17,7 +17,7 @@ NOINLINE gs_real gs_time_span_s(int64_t t1_us, int64_t t0_us)
 
 int64_t gs_time_add_s(int64_t t_us, gs_real ds)
 {
-    if (!gs_time_ok(t_us) || !(GS_FABS(ds) < GS_R(2147483648.0))) return GS_T_NONE;  /* NaN fails too */
+    if (!gs_time_ok(t_us) || !(GS_FABSR(ds) < GS_R(2147483648.0))) return GS_T_NONE;  /* NaN fails too */
     /* whole seconds and the rest: the rest (|x| < 1) scales to microseconds with its
      * full precision, and both conversions are single instructions */
     int32_t whole_s = (int32_t)ds;
