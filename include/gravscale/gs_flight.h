@@ -187,8 +187,7 @@ typedef struct {
 #endif
 } gs_flight;
 
-/* A build with a baked profile (src/core/gs_cfg_in.h) reads that one, whatever cfg says: its
- * caller checks cfg against it (gs_pipeline_init does). */
+/* A build with a baked profile (src/core/gs_cfg_in.h) refuses any other cfg (GS_EINVAL). */
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx);
 /* Time flights by the feet: two foot points per frame (gs_flight_feet), lifting delta_rel

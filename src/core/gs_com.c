@@ -151,9 +151,7 @@ static float v_len(vec2 a) { return sqrtf(a.x * a.x + a.y * a.y); }
 static NOINLINE float acos_deg(float cs)
 {
     cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
-    /* gs_acosf's atan2 form without its range test: after the clamp only a NaN is out of range, and atan2 keeps it */
-    float rad = GS_REAL_IS_FLOAT ? gs_atan2f(sqrtf((1.0f - cs) * (1.0f + cs)), cs) : acosf(cs);
-    return rad * RAD_TO_DEG;
+    return GS_ACOSF_CLAMPED(cs) * RAD_TO_DEG;
 }
 
 /* 0 at x0, 1 at x1 (either order), linear and clamped between. */

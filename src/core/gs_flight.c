@@ -328,8 +328,7 @@ static bool span_cfg_us(float s, int32_t *span_us)
 gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring *ring,
                          uint32_t *keep, bool rigid, gs_event_fn on_event, void *ctx)
 {
-    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP) return GS_EINVAL;
-    /* (a baked build reads its baked configuration, never cfg: gs_pipeline_init refuses any other) */
+    if (!f || !cfg || !ring || !keep || ring->capacity >= GS_FLIGHT_IDX_KEEP || !gs_cfg_is_baked(cfg)) return GS_EINVAL;
     memset(f, 0, sizeof *f);  /* (GS_FS_IDLE, no frame interval, no feet, no close pending) */
     f->cfg = cfg;
     f->ring = ring;

@@ -59,7 +59,7 @@ float gs_atan2f(float y, float x)
 float gs_acosf(float x)
 {
     if (!(x >= -1.0f && x <= 1.0f)) return NAN;
-    return gs_atan2f(sqrtf((1.0f - x) * (1.0f + x)), x);
+    return gs_acosf_clamped(x);
 }
 
 /* x = k pi/2 + r with |r| <= pi/4 (a little more at ties); k mod 4 in *quad. The

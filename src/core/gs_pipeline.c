@@ -104,7 +104,8 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     p->sessions = GS_WITH_POSE && !is_point(layout);
     if (GS_WITH_POSE)
         gs_session_init(&p->session, gs_time_us_of_cfg_s(in->session_absence_s), (gs_real)in->session_new_body_rel);
-    st = gs_flight_init(&p->flight, &p->cfg, &p->ring, scratch, is_point(layout),
+    /* (a baked build hands the flight its constant: checked above, and the flight's check folds) */
+    st = gs_flight_init(&p->flight, GS_CFG_IN(&p->cfg), &p->ring, scratch, is_point(layout),
                         on_flight_event, p);
     if (st == GS_OK && !is_point(layout))
         gs_flight_use_feet(&p->flight, is_blaze(layout) ? TOE_LIFT_REL : ANKLE_LIFT_REL, is_blaze(layout));
