@@ -30,6 +30,13 @@
 #define LAND_G_REL  5.8f   /* gravity in statures per s^2 (9.81 m/s^2 over a 1.7 m body): a landing foot's fall */
 #define WAIT_SLOTS  2u    /* history slots 0 and 1: the frame after the pending one, and the pending one */
 
+/* the size build's outlining heuristics keep these two as calls, though inline they are smaller */
+#ifdef __OPTIMIZE_SIZE__
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define ALWAYS_INLINE inline
+#endif
+
 /* one copy: called for nearly every height read */
 static NOINLINE bool fin(float v) { return gs_finite_f(v); }
 
@@ -75,7 +82,7 @@ static unsigned slot(uint32_t back) { return back + WAIT_SLOTS; }
 static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - WAIT_SLOTS ? ft->n : GS_FEET_HIST - WAIT_SLOTS; }
 
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
-static uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
+static ALWAYS_INLINE uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
 
 /* the point's height `back` frames before the newest (inline: one load at a fixed slot, shorter than a call) */
 static inline float u_at(const gs_foot *f, uint32_t back) { return f->u_px[slot(back)]; }
@@ -98,7 +105,7 @@ static NOINLINE unsigned known_heights(const gs_feet *ft, const gs_foot *f, floa
 
 /* The newest crossing of level L among the n known heights, rising (up) or falling: the
  * index i of the frame after it (uk[i + 1] the one before), n when none. */
-static unsigned crossing_at(const float *uk, unsigned n, float L, bool up)
+static ALWAYS_INLINE unsigned crossing_at(const float *uk, unsigned n, float L, bool up)
 {
     for (unsigned i = 0; i + 1u < n; i++)
         if ((uk[i + 1u] <= L) == up && (uk[i] <= L) != up) return i;
