@@ -36,18 +36,9 @@ gs_status gs_ring_init(gs_ring *r, gs_sample *storage, uint32_t capacity);
  * beyond GS_T_MAX_US); GS_EORDER: s is older than the newest sample (an equal
  * time is stored). */
 gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s);
-/* t_us (not older than the newest) is a span or more after the newest sample: every
- * sample held leaves the ring when it is stored. The difference as uint64 is exact for
- * any two gs_time_ok times. */
-static inline bool gs_ring_gap(const gs_ring *r, int64_t t_us)
-{
-    return r->t_last_us != GS_T_NONE && (uint64_t)t_us - (uint64_t)r->t_last_us >= (uint64_t)GS_RING_SPAN_US;
-}
 /* gs_ring_push without its checks, for a caller that made them (r initialised, s->t_us
  * gs_time_ok and not older than the newest sample). */
 void gs_ring_store(gs_ring *r, const gs_sample_full *s);
-/* gs_ring_store for a caller that has taken gap = gs_ring_gap(r, s->t_us) already. */
-void gs_ring_store_gap(gs_ring *r, const gs_sample_full *s, bool gap);
 
 /* The accessors below are read per sample by the fits and the flight: inline where
  * the build optimises for speed (hosts), one out-of-line copy in gs_ring.c where it

@@ -175,10 +175,11 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
     if (s->t_us == last_us) return GS_OK;  /* a repeated frame carries nothing new */
     if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
-     * left open must close on them first (as it would on any long gap) */
-    const bool gap = gs_ring_gap(&p->ring, s->t_us);
-    if (gap) gs_flight_break(&p->flight);
-    gs_ring_store_gap(&p->ring, s, gap);  /* (checked above as gs_ring_push would) */
+     * left open must close on them first (as it would on any long gap); the
+     * difference as uint64 is exact for any two accepted times */
+    if (last_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
+        gs_flight_break(&p->flight);
+    gs_ring_store(&p->ring, s);  /* (checked above as gs_ring_push would) */
     if (feet_xy) gs_flight_feet(&p->flight, s->t_us, feet_xy, feet_xy + GS_FEET_POINTS, s->size_px);
     if (GS_WITH_TRACE && p->flight.trace && p->on_event) {
         gs_event ev;

@@ -104,24 +104,21 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
 
 void gs_ring_store(gs_ring *r, const gs_sample_full *s)
 {
-    gs_ring_store_gap(r, s, gs_ring_gap(r, s->t_us));
-}
-
-void gs_ring_store_gap(gs_ring *r, const gs_sample_full *s, bool gap)
-{
     int64_t t = s->t_us;
-    if (gap) {
-        r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
-    } else {
-        /* ages are exact below 2^32 us: drop the samples that reached the span (none
-         * is held before the first) */
-        uint32_t lo = (uint32_t)(uint64_t)t;
-        uint64_t oldest = r->valid_from;
-        while (oldest < r->head &&
-               (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
-            oldest++;
+    if (r->t_last_us != GS_T_NONE) {
+        /* t - newest as uint64: exact for any two accepted times (up to 2^63) */
+        if ((uint64_t)t - (uint64_t)r->t_last_us >= (uint64_t)GS_RING_SPAN_US) {
+            r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
+        } else {
+            /* ages are exact below 2^32 us: drop the samples that reached the span */
+            uint32_t lo = (uint32_t)(uint64_t)t;
+            uint64_t oldest = r->valid_from;
+            while (oldest < r->head &&
+                   (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
+                oldest++;
+            }
+            r->valid_from = oldest;
         }
-        r->valid_from = oldest;
     }
     /* a full ring overwrites its oldest sample: the capacity newest stay held */
     if (r->head - r->valid_from >= r->capacity) r->valid_from = r->head - r->capacity + 1u;
