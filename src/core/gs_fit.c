@@ -201,7 +201,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
 {
     gs_par par;
     gs_real *cx = &par.c[0], *cy = &par.c[3], col[3], ts, ts2, ssr;
-    const gs_real *rk = f->r; /* row k of R: its diagonal first */
+    const gs_real *rk; /* row k of R: its diagonal first (f checked first) */
     int k;
     if (!f || !out) {
         return GS_EINVAL;
@@ -214,6 +214,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     col[0] = fabs(f->r[0]);
     col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
     col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
+    rk = f->r;
     for (k = 0; k < 3; rk += 3 - k, k++) {
         /* (an infinite diagonal makes its column's norm infinite or NaN: refused too) */
         gs_real d = fabs(*rk);
