@@ -1312,10 +1312,10 @@ static uint8_t close_bounds(gs_flight *f, gs_close *c)
     if (GS_WITH_POSE && FEET_ON(f) && falls) {
         gs_feet_flush(&f->feet);  /* the newest frame too: the landing may be in it */
         int64_t apex_us = fit_apex_us(r);
-        int64_t c1 = t_at(f, R);  /* ... and ends */
+        int64_t c1 = t_at(f, R);  /* ... and ends (held where L is: R lies between L and the newest) */
         bool known = apex_us != GS_T_NONE && c0 != GS_T_NONE;
         int64_t c0_from = known ? c0 - FEET_BEFORE_COM_US : 0;  /* the feet's events count from here */
-        if (known && c1 != GS_T_NONE) {
+        if (known) {
 
             /* (both within the local range: near the flight's held samples) */
             int64_t F0_us = gs_feet_takeoff(&f->feet, c0_from, apex_us, &c->floor_off_px);
