@@ -676,8 +676,10 @@ static NOINLINE gs_status robust_fit(gs_flight *f, uint32_t first, uint32_t coun
  * when true (scratch otherwise). */
 static bool refit_range(gs_flight *f, uint32_t lo, uint32_t hi, gs_fit_result *r)
 {
+    /* (every caller's hi is an examined sample, below the head: the ring holding one
+     * range [oldest, head), hi > lo is held where lo is) */
     int32_t t_lo = lt_at(f, lo), t_hi = lt_at(f, hi);
-    if (t_lo == GS_LT_NONE || t_hi == GS_LT_NONE || hi <= lo) return false;
+    if (t_lo == GS_LT_NONE || hi <= lo) return false;
     uint32_t count = (uint32_t)(hi - lo + 1);
     float min_scale = (float)noise_floor(f);  /* Tukey scale never below the noise: only gross outliers lose weight */
     if (robust_fit(f, lo, count, GS_FIT_IRLS, min_scale, r) != GS_OK)
