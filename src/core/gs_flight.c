@@ -1057,10 +1057,10 @@ static int32_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int
 /* ---- closing a candidate ---------------------------------------------------- */
 
 /* median of n <= MEDIAN_MAX values and its standard error (from the MAD) */
+_Static_assert(GS_STAND_KEEP <= MEDIAN_MAX, "the kept standing sizes fit a median's set");
 static gs_real median_se(const float *v, uint32_t n, gs_real *se_out)
 {
     float tmp[MEDIAN_MAX], dev[MEDIAN_MAX];
-    if (n > MEDIAN_MAX) n = MEDIAN_MAX;
     memcpy(tmp, v, n * sizeof tmp[0]);
     gs_real med = median_f(tmp, n);
     if (n >= 2) {
