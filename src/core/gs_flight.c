@@ -1003,16 +1003,16 @@ static gs_real pw_ssr_at(pw_sums *P, int32_t T, int side, gs_real alpha_min_px, 
 }
 #endif
 
-/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples;
- * edge_in: the grown flight's edge, edge_out: the outermost contact sample. */
+/* Find the boundary time on one side by grid search. [lo, hi]: flight plus contact samples,
+ * the outermost contact sample at the side's end (lo: take-off, hi: landing); edge_in: the
+ * grown flight's edge. */
 static int32_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int side,
-                               uint32_t edge_in, uint32_t edge_out, gs_real penalty,
-                               const gs_fit_result *r)
+                               uint32_t edge_in, gs_real penalty, const gs_fit_result *r)
 {
     gs_real alpha_min_px = CONTACT_MIN_G * r->a_px_s2;
     gs_real alpha_max_px = (side < 0 ? TAKEOFF_MAX_G : LANDING_MAX_G) * r->a_px_s2;
     /* all held: the contact samples were tested, the flight lies between them and the newest */
-    int32_t t_lo = lt_at(f, lo), t_hi = lt_at(f, hi), t_in = lt_at(f, edge_in), t_out = lt_at(f, edge_out);
+    int32_t t_lo = lt_at(f, lo), t_hi = lt_at(f, hi), t_in = lt_at(f, edge_in);
     if (t_hi <= t_lo) return GS_LT_NONE;
     /* search between the outermost contact sample and a little inside the flight: the grid
      * reaches at most a frame interval (2^26 us) beyond the held samples, and spans it less
@@ -1020,7 +1020,7 @@ static int32_t refine_boundary(const gs_flight *f, uint32_t lo, uint32_t hi, int
     int32_t dt = frame_dt_us(f);
     int32_t inside = BOUNDARY_IN_US > dt ? BOUNDARY_IN_US : dt;
     int32_t t_edge = t_in + (side < 0 ? inside : -inside);
-    int32_t t_from = side < 0 ? t_out : t_edge, t_to = side < 0 ? t_edge : t_out;
+    int32_t t_from = side < 0 ? t_lo : t_edge, t_to = side < 0 ? t_edge : t_hi;
     uint32_t span_us = (uint32_t)t_to - (uint32_t)t_from;
     uint32_t n_steps = frame_steps(f, span_us, BOUNDARY_STEPS);
     int steps = n_steps < 1 ? 1 : n_steps > 400 ? 400 : (int)n_steps;
@@ -1211,7 +1211,7 @@ static int32_t boundary_time(const gs_flight *f, const gs_close *c, int side, bo
     if (n >= 2) {
         gs_real sig = fit_sigma(f, r);
         return refine_boundary(f, side < 0 ? *outer : other_edge, side < 0 ? other_edge : *outer,
-                               side, edge, *outer, DROP_PENALTY * sig * sig, r);
+                               side, edge, DROP_PENALTY * sig * sig, r);
     }
     if (n == 1) {
         int32_t t_first = lt_at(f, first), t_edge = lt_at(f, edge);  /* both held: L is */
