@@ -1409,10 +1409,6 @@ static uint8_t close_final(gs_flight *f, gs_close *c)
         if (!gs_fit_kept(f->keep, (uint32_t)(i - in_lo))) n_out++;
     }
 
-    /* sub-frame times: fall back to half a frame outside the outermost flight sample */
-    int32_t half_dt = frame_dt_us(f) / 2;
-    if (T0 == GS_LT_NONE) T0 = t_first - half_dt;
-    if (T1 == GS_LT_NONE) T1 = t_last + half_dt;
     /* the flight is the feet's time off the floor where they were seen to leave and to land */
     bool feet = GS_WITH_POSE && c->feet;  /* (no layout with feet: their code folds away) */
     int32_t F1 = GS_WITH_POSE ? c->F1_lus : GS_LT_NONE;
@@ -1420,6 +1416,11 @@ static uint8_t close_final(gs_flight *f, gs_close *c)
         T0 = c->F0_lus;
         T1 = F1;
     }
+    /* sub-frame times: fall back to half a frame outside the outermost flight sample (the
+     * feet's are both known) */
+    int32_t half_dt = frame_dt_us(f) / 2;
+    if (T0 == GS_LT_NONE) T0 = t_first - half_dt;
+    if (T1 == GS_LT_NONE) T1 = t_last + half_dt;
     int64_t T0_us = abs_of(f, T0), T1_us = abs_of(f, T1);
 
     gs_event ev;
