@@ -540,7 +540,9 @@ static bool plausible_fall(const gs_flight *f, const gs_fit_result *r, gs_real s
     if (!(cosang > (gs_real)GS_COS(max_ang * GS_PI / GS_R(180.0)))) return false;
     gs_real a_hi = r->a_px_s2 + GS_R(2.0) * rel_se * r->a_px_s2, a_lo = r->a_px_s2 - GS_R(2.0) * rel_se * r->a_px_s2;
     gs_real a_min = -(gs_real)INFINITY, a_max = (gs_real)INFINITY;  /* no size, no flight yet: any */
-    if (finite_r(size_px) && size_px > GS_R(0.0)) {
+    /* (size_px is NaN or a median of measured sizes, within their range: in float it is
+     * positive and finite exactly where it is so in gs_real) */
+    if (size_ok((float)size_px)) {
         /* the size this acceleration implies, h = size g / a, within the plausible range */
         a_min = size_px * f->g_m_s2 / ((gs_real)CFG(f)->size_max_m * EMIT_FACTOR);
         a_max = size_px * f->g_m_s2 / ((gs_real)CFG(f)->size_min_m / EMIT_FACTOR);
