@@ -696,10 +696,11 @@ static bool refit_range(gs_flight *f, uint32_t lo, uint32_t hi, gs_fit_result *r
     return gs_fit_solve(&f->fit, r) == GS_OK;
 }
 
-/* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit through
- * the alarm: if the samples at the edge then sit on the parabola, it was a
- * false alarm (true contact deviates by far more than a refit can absorb). */
-static bool alarm_is_false(gs_flight *f, uint32_t lo, uint32_t hi, uint32_t edge, int side)
+/* A CUSUM alarm from a fit of few samples can be the fit's fault. Refit [lo, hi] through
+ * the alarm, at its edge on the side (+1: hi, -1: lo): if the samples at the edge then sit
+ * on the parabola, it was a false alarm (true contact deviates by far more than a refit can
+ * absorb). */
+static bool alarm_is_false(gs_flight *f, uint32_t lo, uint32_t hi, int side)
 {
     gs_fit_result r;
     if (!refit_range(f, lo, hi, &r)) return false;
@@ -707,7 +708,7 @@ static bool alarm_is_false(gs_flight *f, uint32_t lo, uint32_t hi, uint32_t edge
     if (r.rms_px / GS_SQRT(GS_R(2.0)) > VERIFY_RMS * noise_floor(f)) return false;
     uint32_t checked = 0;
     uint32_t stop = side > 0 ? lo : hi;  /* walking inward from the edge */
-    for (uint32_t i = edge, k = 0; k < 4 && checked < 2; k++) {
+    for (uint32_t i = side > 0 ? hi : lo, k = 0; k < 4 && checked < 2; k++) {
         gs_sample_full s_b;
         gs_real z;
         if (tested_at(f, &r, i, &s_b, &z)) {
@@ -1154,7 +1155,7 @@ static uint8_t grow_left_step(gs_flight *f, gs_close *c, bool all, bool *spent)
         /* contact at walk_i, or a refit through it shows a false alarm */
         uint32_t i = c->walk_i;
         *spent = true;
-        if (!alarm_is_false(f, i, f->fl_last, i, -1)) {
+        if (!alarm_is_false(f, i, f->fl_last, -1)) {
             c->left_alarm = i;
             return GS_CLOSE_GROWN;
         }
@@ -2007,7 +2008,7 @@ static void airborne_sample(gs_flight *f, uint32_t idx, const gs_sample_full *s)
         goto landed;
     if (contact) {  /* decelerated by the ground: landed? */
         memo_forget(f);
-        if (!alarm_is_false(f, f->fl_first, idx, idx, +1)) goto landed;
+        if (!alarm_is_false(f, f->fl_first, idx, +1)) goto landed;
         f->fl_last = idx;   /* the refit took every sample through idx */
         f->cusum = GS_R(0.0);
         f->pend_ok = 0;
