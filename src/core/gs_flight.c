@@ -102,6 +102,11 @@ static NOINLINE bool finite_r(gs_real x) { return gs_finite_r(x); }
 static uint64_t ring_idx(const gs_flight *f, uint32_t i) { return f->base + i; }
 static uint32_t idx_of(const gs_flight *f, uint64_t ring_i) { return (uint32_t)(ring_i - f->base); }
 
+/* The ring's head and its oldest held sample as offsets (f->ring is set at init, never NULL:
+ * read without the accessors' NULL test) */
+static uint32_t head_idx(const gs_flight *f) { return idx_of(f, f->ring->head); }
+static uint32_t oldest_idx(const gs_flight *f) { return idx_of(f, f->ring->valid_from); }
+
 /* Ring sample i unpacked into *buf; NULL when the ring no longer holds it. */
 static const gs_sample_full *at(const gs_flight *f, uint32_t i, gs_sample_full *buf)
 {
@@ -633,7 +638,7 @@ static NOINLINE void fit_add(gs_flight *f, const gs_sample_full *s)
 /* the oldest sample a flight may reach back to: held, and after the last closed candidate */
 static NOINLINE uint32_t history_floor(const gs_flight *f)
 {
-    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
+    uint32_t oldest = oldest_idx(f);
     return f->quiet_from > oldest ? f->quiet_from : oldest;
 }
 
@@ -1600,7 +1605,7 @@ static void close_begin(gs_flight *f, gs_close *c, uint32_t newest, uint32_t rig
     c->newest = newest;
     c->right_alarm = right_alarm;
     c->truncated = truncated;
-    c->head = idx_of(f, gs_ring_head(f->ring));
+    c->head = head_idx(f);
     c->stage = refit ? GS_CLOSE_REFIT : GS_CLOSE_START;
     memo_forget(f);
 }
@@ -1675,7 +1680,7 @@ static bool may_stand(gs_flight *f, gs_close *c, uint32_t i)
 static bool close_due(gs_flight *f)
 {
     gs_close *c = &f->close;
-    uint32_t head = idx_of(f, gs_ring_head(f->ring));
+    uint32_t head = head_idx(f);
     int64_t t_new_us = f->ring->t_last_us;
     if (f->trace || f->close_whole || head - c->head >= GS_CLOSE_LAG_FRAMES || head + 1u - c->low >= f->ring->capacity ||
         (t_new_us != GS_T_NONE && t_new_us - c->t_end_us >= CLOSE_LAG_US))
@@ -1734,8 +1739,8 @@ static void seed_found(gs_flight *f, uint32_t newest)
  * may_stand), low: the oldest sample it may read */
 static void job_wait(gs_flight *f, gs_close *c, int64_t t_us, uint32_t n_ground, uint32_t low)
 {
-    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
-    c->head = idx_of(f, gs_ring_head(f->ring));
+    uint32_t oldest = oldest_idx(f);
+    c->head = head_idx(f);
     c->t_end_us = t_us;
     c->low = low > oldest ? low : oldest;
     c->checked = f->next;
@@ -2049,7 +2054,7 @@ static void rebase(gs_flight *f)
         offsetof(gs_flight, close.in_lo), offsetof(gs_flight, close.in_hi), offsetof(gs_flight, close.apex),
 #endif
     };
-    uint64_t head = gs_ring_head(f->ring);
+    uint64_t head = f->ring->head;
     if (head - f->base <= 2u * (uint64_t)GS_FLIGHT_IDX_KEEP) return;
     uint32_t by = idx_of(f, head - GS_FLIGHT_IDX_KEEP);
     f->base += by;
@@ -2063,8 +2068,8 @@ static void rebase(gs_flight *f)
 static void examine(gs_flight *f)
 {
     set_time_base(f);
-    uint32_t head = idx_of(f, gs_ring_head(f->ring));
-    uint32_t oldest = idx_of(f, gs_ring_oldest(f->ring));
+    uint32_t head = head_idx(f);
+    uint32_t oldest = oldest_idx(f);
     if (f->next < oldest) f->next = oldest;  /* fell behind the ring: skip what was lost */
     while (f->next < head) {
         uint32_t idx = f->next++;
