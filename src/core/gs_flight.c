@@ -2080,9 +2080,8 @@ static void examine(gs_flight *f)
 #endif
         /* a gap is frames missing from the source; a light frame (the head out of
          * the picture) is present, only not used */
-        bool present = s && s->w > 0.0f;
-        if (present && !usable(s)) { f->last_t_us = s->t_us; continue; }
-        if (!present) continue;
+        if (!s || !(s->w > 0.0f)) continue;
+        if (!usable(s)) { f->last_t_us = s->t_us; continue; }
         if (f->last_t_us != GS_T_NONE) {
             int64_t dt = s->t_us - f->last_t_us;
             track_frame_dt(f, dt);
