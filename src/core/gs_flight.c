@@ -1830,10 +1830,12 @@ static void update_standing(gs_flight *f, const gs_sample_full *s, gs_real speed
     f->stand_last_us = s->t_us;
     /* body axis -> image up, until flights measure gravity directly */
     if (!f->up_from_flight && gs_finite2_f(s->up_x, s->up_y)) {
-        gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
-        gs_real ux = (GS_R(1.0) - kw) * f->up_x + kw * (gs_real)s->up_x;
-        gs_real uy = (GS_R(1.0) - kw) * f->up_y + kw * (gs_real)s->up_y;
-        if (f->up_n == 0) { ux = s->up_x; uy = s->up_y; }
+        gs_real ux = (gs_real)s->up_x, uy = (gs_real)s->up_y;  /* the first as it is */
+        if (f->up_n > 0) {
+            gs_real kw = f->up_n < 20 ? GS_R(1.0) / (gs_real)(f->up_n + 1) : GS_R(0.05);
+            ux = (GS_R(1.0) - kw) * f->up_x + kw * ux;
+            uy = (GS_R(1.0) - kw) * f->up_y + kw * uy;
+        }
         set_up(f, ux, uy);
         f->up_n++;
     }
