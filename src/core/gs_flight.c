@@ -1774,7 +1774,7 @@ static void seed_begin(gs_flight *f, uint32_t apex, uint32_t newest, int64_t t_u
 #endif
 
 /* |du/dt| against the sample about lag_us back (frame jitter is not motion); NaN unknown */
-static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full *s, gs_real u, int64_t lag_us)
+static gs_real speed_px_s(const gs_flight *f, uint32_t idx, const gs_sample_full *s, gs_real u, uint32_t lag_us)
 {
     uint32_t k = frame_steps(f, lag_us, 1);
     if (k < 1) k = 1;
