@@ -626,6 +626,7 @@ size_t gs_layout_kp_count(gs_layout layout)
 static float table_total_pct(const seg_table *t)
 {
     float s = t->mass_pct[GS_SEG_HEAD] + t->mass_pct[GS_SEG_TRUNK];
+#pragma GCC unroll 6 /* a constant table's sum folds to a constant */
     for (int k = GS_SEG_UPPER_ARM; k < GS_SEG_COUNT; k++) {
         s += 2.0f * t->mass_pct[k];
     }
@@ -684,9 +685,11 @@ static void com_result(const frame *f, float total, gs_com_out *out)
     }
 }
 
-static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_method stature,
+/* (the table by its enum: a build whose table is a constant folds its sums) */
+static void skeleton_com(gs_layout layout, gs_mass_table table, gs_stature_method stature,
                          float min_conf, const gs_kp *kp, gs_com_out *out)
 {
+    const seg_table *tb = k_tables[table];
     frame f;
     load(&f, GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33), min_conf, kp);
 
@@ -768,7 +771,7 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         return GS_OK;
     }
 #if GS_WITH_POSE
-    skeleton_com(layout, k_tables[table], stature, min_conf, kp, out);
+    skeleton_com(layout, table, stature, min_conf, kp, out);
 #endif
     return GS_OK;
 }
