@@ -190,7 +190,6 @@ typedef struct {
     uint32_t have; /* bit k: observed or rebuilt */
     uint32_t used; /* bit k: observed keypoint k entered the COM */
     wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
-    bool blaze; /* BlazePose-33 input: hands and feet have extra keypoints */
     float c[K_N];
     vec2 p[K_N];
 } frame;
@@ -302,7 +301,6 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
         }
         f->obs = obs;
         f->have = obs;
-        f->blaze = blaze;
         return;
     }
 #endif
@@ -316,7 +314,6 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
         }
     }
     f->have = f->obs;
-    f->blaze = blaze;
 }
 
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
@@ -440,9 +437,9 @@ static bool blaze_extremity(const frame *f, int dist, bool hand, float c, vec2 *
 }
 
 /* One limb segment: an arm or leg bone between its joints, or a hand or foot
- * beyond the distal joint (wrist/ankle), from the BlazePose extremity keypoints,
- * else along the forearm/shank, else at the joint itself. */
-static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
+ * beyond the distal joint (wrist/ankle), from the BlazePose extremity keypoints
+ * (blaze: BlazePose-33 input), else along the forearm/shank, else at the joint itself. */
+static void add_limb_segment(frame *f, bool blaze, const seg_def *d, float m, float c)
 {
     int prox = d->prox, dist = prox + NEXT_JOINT;
     bool hand = d->seg == GS_SEG_HAND, extremity = hand || d->seg == GS_SEG_FOOT;
@@ -456,7 +453,7 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
     if (!extremity) {
         com = v_lerp(f->p[prox], q, c);
         bits |= BIT(prox);
-    } else if (GS_WITH_BLAZEPOSE33 && f->blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
+    } else if (GS_WITH_BLAZEPOSE33 && blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
         rebuilt = !(f->obs & BIT(dist));
     } else if (has_prox) {
         com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
@@ -464,14 +461,14 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
     add_segment(f, m, com.x, com.y, rebuilt, bits);
 }
 
-static void add_limbs(frame *f, const seg_table *tb)
+static void add_limbs(frame *f, bool blaze, const seg_table *tb)
 {
 #ifndef __OPTIMIZE_SIZE__
 #pragma GCC unroll 12 /* hosts: each segment's kind and joints constant, its tests folded */
 #endif
     for (size_t i = 0; i < sizeof k_limb_segs / sizeof k_limb_segs[0]; i++) {
         const seg_def *d = &k_limb_segs[i];
-        add_limb_segment(f, d, tb->mass_pct[d->seg], tb->c[d->seg]);
+        add_limb_segment(f, blaze, d, tb->mass_pct[d->seg], tb->c[d->seg]);
     }
 }
 
@@ -691,7 +688,8 @@ static void skeleton_com(gs_layout layout, gs_mass_table table, gs_stature_metho
 {
     const seg_table *tb = k_tables[table];
     frame f;
-    load(&f, GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33), min_conf, kp);
+    bool blaze = GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33);
+    load(&f, blaze, min_conf, kp);
 
     /* Stature and body axis do not need the trunk. */
     vec2 up = { NAN, NAN };
@@ -745,7 +743,7 @@ static void skeleton_com(gs_layout layout, gs_mass_table table, gs_stature_metho
     }
     vec2 tc = v_lerp(s, p, tb->c[GS_SEG_TRUNK]);
     add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], tc.x, tc.y, trunk_rebuilt, corners);
-    add_limbs(&f, tb);
+    add_limbs(&f, blaze, tb);
     com_result(&f, table_total_pct(tb), out);
 }
 #endif
