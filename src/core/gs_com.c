@@ -185,13 +185,14 @@ static vec2 wsum_mean(const wsum *s)
 #define BIT(k) (1u << (k))
 #define BIT2(a, b) (BIT(a) | BIT(b))
 
+/* (the COM sums first and the positions before the confidences: shorter addressing on the M4) */
 typedef struct {
+    wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
     uint32_t obs;  /* bit k: keypoint k detected with enough confidence */
     uint32_t have; /* bit k: observed or rebuilt */
     uint32_t used; /* bit k: observed keypoint k entered the COM */
-    wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
-    float c[K_N];
     vec2 p[K_N];
+    float c[K_N];
 } frame;
 
 /* Keypoint a minus keypoint b: the helpers below take keypoint indices (smaller calls). */
