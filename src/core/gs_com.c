@@ -516,8 +516,12 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
     if (!(len > 0.0f)) {
         return false;
     }
-    *up = v_scale(d, 1.0f / len);
-    *stature_px = v_dot(v_sub(hc, fc), *up) / (h->e / h->w - ft->e / ft->w);
+    vec2 u = v_scale(d, 1.0f / len);
+    if (!gs_finite2_f(u.x, u.y)) {
+        return false; /* absurd coordinates overflow float (the stature would not be finite either) */
+    }
+    *up = u;
+    *stature_px = v_dot(v_sub(hc, fc), u) / (h->e / h->w - ft->e / ft->w);
     return true;
 }
 
@@ -701,10 +705,6 @@ static void skeleton_com(gs_layout layout, gs_mass_table table, gs_stature_metho
     }
     if (gs_finite_f(st)) { /* else NaN: absurd coordinates overflow float */
         out->stature_px = st;
-    }
-    if (!gs_finite2_f(up.x, up.y)) {
-        up = (vec2){ NAN, NAN };
-        axis_from_body = false;
     }
 
     /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
