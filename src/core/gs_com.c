@@ -477,8 +477,12 @@ static void add_limbs(frame *f, bool blaze, const seg_table *tb)
 
 /* Stature landmarks in summation order, head group first; fraction and prior per kind. */
 enum { M_EYE, M_EAR, M_NOSE, M_ANKLE, M_HEEL, M_TOE, M_KINDS };
-static const float k_mark_frac[M_KINDS] = { F_EYE, F_EAR, F_NOSE, F_ANKLE, F_HEEL, F_TOE };
-static const float k_mark_prior[M_KINDS] = { P_EYE, P_EAR, P_NOSE, P_ANKLE, P_HEEL, P_TOE };
+typedef struct {
+    float frac, prior;
+} mark_kind;
+static const mark_kind k_mark_kinds[M_KINDS] = {
+    { F_EYE, P_EYE }, { F_EAR, P_EAR }, { F_NOSE, P_NOSE }, { F_ANKLE, P_ANKLE }, { F_HEEL, P_HEEL }, { F_TOE, P_TOE },
+};
 static const uint8_t k_marks[][2] = {
     { K_LEYE, M_EYE },     { K_REYE, M_EYE },     { K_LEAR, M_EAR },   { K_REAR, M_EAR },
     { K_NOSE, M_NOSE },    { K_LANK, M_ANKLE },   { K_RANK, M_ANKLE }, { K_LHEEL, M_HEEL },
@@ -496,8 +500,9 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 #endif
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
+        const mark_kind *mk = &k_mark_kinds[kind];
         /* (a landmark not observed adds 0 to sums that start at +0, never -0: no change) */
-        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k].x, f->p[k].y, k_mark_frac[kind]);
+        wsum_add(&g[kind >= M_ANKLE], f->c[k] * mk->prior, f->p[k].x, f->p[k].y, mk->frac);
     }
     const wsum *h = &g[0], *ft = &g[1];
     if (!(h->w > 0.0f) || !(ft->w > 0.0f)) {
