@@ -672,8 +672,9 @@ static void com_result(const frame *f, float total, gs_com_out *out)
         n++;
     }
 #else
-    for (int k = 0; k < K_N; k++) {
-        if (f->used & BIT(k)) {
+    int k = 0;
+    for (uint32_t u = f->used; u != 0u; u >>= 1, k++) { /* up to the last used keypoint */
+        if (u & 1u) {
             csum += f->c[k];
             n++;
         }
