@@ -449,15 +449,17 @@ static void add_limb_segment(frame *f, bool blaze, const seg_def *d, float m, fl
         return;
     }
     vec2 q = f->p[dist], com = q;
+    /* prox -> dist: the bone, or the forearm/shank behind a hand/foot (used only with prox) */
+    vec2 bone = v_sub(q, f->p[prox]);
     uint32_t bits = BIT(dist);
     bool rebuilt = is_rebuilt(f, prox, dist); /* also when prox is missing */
     if (!extremity) {
-        com = v_lerp(f->p[prox], q, c);
+        com = v_add(f->p[prox], v_scale(bone, c));
         bits |= BIT(prox);
     } else if (GS_WITH_BLAZEPOSE33 && blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
         rebuilt = !(f->obs & BIT(dist));
     } else if (has_prox) {
-        com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
+        com = v_add(q, v_scale(bone, hand ? c : FOOT_BELOW_ANKLE));
     }
     add_segment(f, m, com.x, com.y, rebuilt, bits);
 }
