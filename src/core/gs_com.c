@@ -326,9 +326,15 @@ static NOINLINE void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
     if (seen == 0 || seen == BIT2(l, l + 1) || !all_in(f->obs, BIT2(ol, ol + 1))) {
         return;
     }
-    int known = seen == BIT(l) ? l : l + 1, lost = 2 * l + 1 - known;
     /* the other pair's left -> right vector, backwards from a right corner */
-    f->p[lost] = kp_extend(f, known, ol + 1, ol, known == l ? scale : -scale);
+    int known = l + 1, lost = l;
+    float s = -scale;
+    if (seen == BIT(l)) {
+        known = l;
+        lost = l + 1;
+        s = scale;
+    }
+    f->p[lost] = kp_extend(f, known, ol + 1, ol, s);
     f->have |= BIT(lost);
 }
 
