@@ -185,14 +185,14 @@ static vec2 wsum_mean(const wsum *s)
 #define BIT(k) (1u << (k))
 #define BIT2(a, b) (BIT(a) | BIT(b))
 
+/* (the COM sums first and the positions before the confidences: shorter addressing on the M4) */
 typedef struct {
+    wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
     uint32_t obs;  /* bit k: keypoint k detected with enough confidence */
     uint32_t have; /* bit k: observed or rebuilt */
     uint32_t used; /* bit k: observed keypoint k entered the COM */
-    wsum com; /* segment masses and their COMs; e: share observed (rebuilt counts half) */
-    bool blaze; /* BlazePose-33 input: hands and feet have extra keypoints */
-    float c[K_N];
     vec2 p[K_N];
+    float c[K_N];
 } frame;
 
 /* Keypoint a minus keypoint b: the helpers below take keypoint indices (smaller calls). */
@@ -302,7 +302,6 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
         }
         f->obs = obs;
         f->have = obs;
-        f->blaze = blaze;
         return;
     }
 #endif
@@ -316,7 +315,6 @@ static void load(frame *f, bool blaze, float min_conf, const gs_kp *kp)
         }
     }
     f->have = f->obs;
-    f->blaze = blaze;
 }
 
 /* Rebuild one missing shoulder from the hip pair (or a hip from the shoulders):
@@ -328,9 +326,15 @@ static NOINLINE void rebuild_trunk_corner(frame *f, int l, int ol, float scale)
     if (seen == 0 || seen == BIT2(l, l + 1) || !all_in(f->obs, BIT2(ol, ol + 1))) {
         return;
     }
-    int known = seen == BIT(l) ? l : l + 1, lost = 2 * l + 1 - known;
     /* the other pair's left -> right vector, backwards from a right corner */
-    f->p[lost] = kp_extend(f, known, ol + 1, ol, known == l ? scale : -scale);
+    int known = l + 1, lost = l;
+    float s = -scale;
+    if (seen == BIT(l)) {
+        known = l;
+        lost = l + 1;
+        s = scale;
+    }
+    f->p[lost] = kp_extend(f, known, ol + 1, ol, s);
     f->have |= BIT(lost);
 }
 
@@ -440,9 +444,9 @@ static bool blaze_extremity(const frame *f, int dist, bool hand, float c, vec2 *
 }
 
 /* One limb segment: an arm or leg bone between its joints, or a hand or foot
- * beyond the distal joint (wrist/ankle), from the BlazePose extremity keypoints,
- * else along the forearm/shank, else at the joint itself. */
-static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
+ * beyond the distal joint (wrist/ankle), from the BlazePose extremity keypoints
+ * (blaze: BlazePose-33 input), else along the forearm/shank, else at the joint itself. */
+static void add_limb_segment(frame *f, bool blaze, const seg_def *d, float m, float c)
 {
     int prox = d->prox, dist = prox + NEXT_JOINT;
     bool hand = d->seg == GS_SEG_HAND, extremity = hand || d->seg == GS_SEG_FOOT;
@@ -451,27 +455,29 @@ static void add_limb_segment(frame *f, const seg_def *d, float m, float c)
         return;
     }
     vec2 q = f->p[dist], com = q;
+    /* prox -> dist: the bone, or the forearm/shank behind a hand/foot (used only with prox) */
+    vec2 bone = v_sub(q, f->p[prox]);
     uint32_t bits = BIT(dist);
     bool rebuilt = is_rebuilt(f, prox, dist); /* also when prox is missing */
     if (!extremity) {
-        com = v_lerp(f->p[prox], q, c);
+        com = v_add(f->p[prox], v_scale(bone, c));
         bits |= BIT(prox);
-    } else if (GS_WITH_BLAZEPOSE33 && f->blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
+    } else if (GS_WITH_BLAZEPOSE33 && blaze && blaze_extremity(f, dist, hand, c, &com, &bits)) {
         rebuilt = !(f->obs & BIT(dist));
     } else if (has_prox) {
-        com = kp_extend(f, dist, dist, prox, hand ? c : FOOT_BELOW_ANKLE);
+        com = v_add(q, v_scale(bone, hand ? c : FOOT_BELOW_ANKLE));
     }
     add_segment(f, m, com.x, com.y, rebuilt, bits);
 }
 
-static void add_limbs(frame *f, const seg_table *tb)
+static void add_limbs(frame *f, bool blaze, const seg_table *tb)
 {
 #ifndef __OPTIMIZE_SIZE__
 #pragma GCC unroll 12 /* hosts: each segment's kind and joints constant, its tests folded */
 #endif
     for (size_t i = 0; i < sizeof k_limb_segs / sizeof k_limb_segs[0]; i++) {
         const seg_def *d = &k_limb_segs[i];
-        add_limb_segment(f, d, tb->mass_pct[d->seg], tb->c[d->seg]);
+        add_limb_segment(f, blaze, d, tb->mass_pct[d->seg], tb->c[d->seg]);
     }
 }
 
@@ -479,8 +485,12 @@ static void add_limbs(frame *f, const seg_table *tb)
 
 /* Stature landmarks in summation order, head group first; fraction and prior per kind. */
 enum { M_EYE, M_EAR, M_NOSE, M_ANKLE, M_HEEL, M_TOE, M_KINDS };
-static const float k_mark_frac[M_KINDS] = { F_EYE, F_EAR, F_NOSE, F_ANKLE, F_HEEL, F_TOE };
-static const float k_mark_prior[M_KINDS] = { P_EYE, P_EAR, P_NOSE, P_ANKLE, P_HEEL, P_TOE };
+typedef struct {
+    float frac, prior;
+} mark_kind;
+static const mark_kind k_mark_kinds[M_KINDS] = {
+    { F_EYE, P_EYE }, { F_EAR, P_EAR }, { F_NOSE, P_NOSE }, { F_ANKLE, P_ANKLE }, { F_HEEL, P_HEEL }, { F_TOE, P_TOE },
+};
 static const uint8_t k_marks[][2] = {
     { K_LEYE, M_EYE },     { K_REYE, M_EYE },     { K_LEAR, M_EAR },   { K_REAR, M_EAR },
     { K_NOSE, M_NOSE },    { K_LANK, M_ANKLE },   { K_RANK, M_ANKLE }, { K_LHEEL, M_HEEL },
@@ -498,8 +508,9 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
 #endif
     for (size_t i = 0; i < sizeof k_marks / sizeof k_marks[0]; i++) {
         int k = k_marks[i][0], kind = k_marks[i][1];
+        const mark_kind *mk = &k_mark_kinds[kind];
         /* (a landmark not observed adds 0 to sums that start at +0, never -0: no change) */
-        wsum_add(&g[kind >= M_ANKLE], f->c[k] * k_mark_prior[kind], f->p[k].x, f->p[k].y, k_mark_frac[kind]);
+        wsum_add(&g[kind >= M_ANKLE], f->c[k] * mk->prior, f->p[k].x, f->p[k].y, mk->frac);
     }
     const wsum *h = &g[0], *ft = &g[1];
     if (!(h->w > 0.0f) || !(ft->w > 0.0f)) {
@@ -518,8 +529,12 @@ static bool anthro_stature(const frame *f, float *stature_px, vec2 *up)
     if (!(len > 0.0f)) {
         return false;
     }
-    *up = v_scale(d, 1.0f / len);
-    *stature_px = v_dot(v_sub(hc, fc), *up) / (h->e / h->w - ft->e / ft->w);
+    vec2 u = v_scale(d, 1.0f / len);
+    if (!gs_finite2_f(u.x, u.y)) {
+        return false; /* absurd coordinates overflow float (the stature would not be finite either) */
+    }
+    *up = u;
+    *stature_px = v_dot(v_sub(hc, fc), u) / (h->e / h->w - ft->e / ft->w);
     return true;
 }
 
@@ -626,6 +641,7 @@ size_t gs_layout_kp_count(gs_layout layout)
 static float table_total_pct(const seg_table *t)
 {
     float s = t->mass_pct[GS_SEG_HEAD] + t->mass_pct[GS_SEG_TRUNK];
+#pragma GCC unroll 6 /* a constant table's sum folds to a constant */
     for (int k = GS_SEG_UPPER_ARM; k < GS_SEG_COUNT; k++) {
         s += 2.0f * t->mass_pct[k];
     }
@@ -664,8 +680,9 @@ static void com_result(const frame *f, float total, gs_com_out *out)
         n++;
     }
 #else
-    for (int k = 0; k < K_N; k++) {
-        if (f->used & BIT(k)) {
+    int k = 0;
+    for (uint32_t u = f->used; u != 0u; u >>= 1, k++) { /* up to the last used keypoint */
+        if (u & 1u) {
             csum += f->c[k];
             n++;
         }
@@ -684,11 +701,14 @@ static void com_result(const frame *f, float total, gs_com_out *out)
     }
 }
 
-static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_method stature,
+/* (the table by its enum: a build whose table is a constant folds its sums) */
+static void skeleton_com(gs_layout layout, gs_mass_table table, gs_stature_method stature,
                          float min_conf, const gs_kp *kp, gs_com_out *out)
 {
+    const seg_table *tb = k_tables[table];
     frame f;
-    load(&f, GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33), min_conf, kp);
+    bool blaze = GS_WITH_BLAZEPOSE33 && (!GS_WITH_COCO17 || layout == GS_LAYOUT_BLAZEPOSE33);
+    load(&f, blaze, min_conf, kp);
 
     /* Stature and body axis do not need the trunk. */
     vec2 up = { NAN, NAN };
@@ -699,10 +719,6 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     }
     if (gs_finite_f(st)) { /* else NaN: absurd coordinates overflow float */
         out->stature_px = st;
-    }
-    if (!gs_finite2_f(up.x, up.y)) {
-        up = (vec2){ NAN, NAN };
-        axis_from_body = false;
     }
 
     /* Trunk: rebuild a lone missing shoulder/hip, then the two centres. */
@@ -742,7 +758,7 @@ static void skeleton_com(gs_layout layout, const seg_table *tb, gs_stature_metho
     }
     vec2 tc = v_lerp(s, p, tb->c[GS_SEG_TRUNK]);
     add_segment(&f, tb->mass_pct[GS_SEG_TRUNK], tc.x, tc.y, trunk_rebuilt, corners);
-    add_limbs(&f, tb);
+    add_limbs(&f, blaze, tb);
     com_result(&f, table_total_pct(tb), out);
 }
 #endif
@@ -768,7 +784,7 @@ gs_status gs_com_compute(gs_layout layout, gs_mass_table table, gs_stature_metho
         return GS_OK;
     }
 #if GS_WITH_POSE
-    skeleton_com(layout, k_tables[table], stature, min_conf, kp, out);
+    skeleton_com(layout, table, stature, min_conf, kp, out);
 #endif
     return GS_OK;
 }
