@@ -1670,8 +1670,9 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
         *out = plain_out;
         return GS_OK;
     }
-    /* the plain run won: run it again (when the LMS one ran after it) so keep and out hold its weights */
-    return have[LMS] ? irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin) : GS_OK;
+    /* the plain run won: run it again so keep and out hold its weights (where no LMS start ran
+     * after it they hold them already: the same deterministic run, the same OK) */
+    return irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin);
 }
 
 static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
