@@ -439,8 +439,9 @@ static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
     if (!s || !sample_usable(s)) {
         return false;
     }
-    /* the span from the centre is exact; the centred, unit-length tau fits a float */
-    out->tau = fit_tau(gs_ring_sample_t_us(wn->ring, s), wn->t0_us, wn->tscale_us_r);
+    /* the span from the centre, exact from the 32-bit times (a usable sample lies in the
+     * window, which spans less than 2^31 us: win_open); the centred, unit-length tau fits a float */
+    out->tau = (gs_real)(int32_t)(s->t_us - (uint32_t)(uint64_t)wn->t0_us) / wn->tscale_us_r;
     out->xy_px[0] = s->x_px;
     out->xy_px[1] = s->y_px;
     out->w = gs_sample_w(s);
