@@ -1730,7 +1730,8 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
  * or fewer than 3 usable ones at distinct times remain. */
 static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint32_t count)
 {
-    int64_t t_min = 0, t_max = 0;  /* absolute times */
+    const gs_sample *lo, *hi; /* the first and the last usable sample (set once m > 0) */
+    int64_t t_min, t_max;  /* absolute times */
     uint32_t i, m = 0;
     for (i = 0; i < count; i++) {
         const gs_sample *s = gs_ring_at(ring, first + i);
@@ -1739,15 +1740,20 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
             return GS_EINVAL;
         }
         if (sample_usable(s)) {
-            /* the ring's times never decrease: the first usable is the earliest, the last the latest */
-            t_max = gs_ring_sample_t_us(ring, s);
             if (m == 0) {
-                t_min = t_max;
+                lo = s;
             }
+            hi = s;
             m++;
         }
     }
-    if (m < 3 || !(t_max > t_min)) {
+    if (m < 3) {
+        return GS_EINVAL;
+    }
+    /* the ring's times never decrease: the first usable is the earliest, the last the latest */
+    t_min = gs_ring_sample_t_us(ring, lo);
+    t_max = gs_ring_sample_t_us(ring, hi);
+    if (!(t_max > t_min)) {
         return GS_EINVAL;
     }
     wn->ring = ring;
