@@ -68,8 +68,8 @@ typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lan
 
 static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
-/* An empty fit at a valid centre and scale (> 0 us): all sums and R zero (all-zero bits are +0.0). */
-static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
+/* An empty fit at a valid centre and scale (> 0 s): all sums and R zero (all-zero bits are +0.0). */
+static void fit_start(gs_fit *f, int64_t t0_us, gs_real tscale_s)
 {
 #if GS_FIT_FAST
     /* field by field: a few vector stores where the memset of the whole is a rep stos */
@@ -83,11 +83,11 @@ static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
     f->ssr_x = f->ssr_y = f->sum_w = GS_R(0.0);
     f->n = 0;
     f->t0_us = t0_us;
-    f->tscale_s = gs_time_span_s(tscale_us, 0);
+    f->tscale_s = tscale_s;
 #else
     memset(f, 0, sizeof *f);
     f->t0_us = t0_us;
-    f->tscale_s = gs_time_span_s(tscale_us, 0);
+    f->tscale_s = tscale_s;
 #endif
 }
 
@@ -97,7 +97,7 @@ void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
         return;
     }
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, tscale_us > 0 ? tscale_us : GS_US_PER_S);
+    fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, gs_time_span_s(tscale_us > 0 ? tscale_us : GS_US_PER_S, 0));
 }
 
 /* The centred, scaled time of t_us: the exact integer span over the scale, both in microseconds. */
@@ -344,8 +344,9 @@ typedef struct {
     uint64_t first;
     uint32_t count;
     uint32_t m; /* usable samples in the window */
-    int64_t t0_us, tscale_us; /* the window's centre and length (> 0, below the ring's 2^31 us span) */
-    gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
+    int64_t t0_us;            /* the window's centre */
+    gs_real tscale_us_r;      /* its length in us (> 0, below the ring's 2^31 us span; exact below 2^24 us in float) */
+    gs_real tscale_s;         /* the same in seconds: its fits' scale (gs_time_span_s) */
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
     gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
@@ -1356,7 +1357,7 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
         }
     }
 #endif
-    fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
+    fit_start(&f, wn->t0_us, wn->tscale_s);
 #if GS_FIT_FAST
     if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE) {
         wsums_cached(wn, model, &base, mode, cut, keep, r2, &a); /* sets every sum */
@@ -1732,6 +1733,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
 {
     const gs_sample *lo, *hi; /* the first and the last usable sample (set once m > 0) */
     int64_t t_min, t_max;  /* absolute times */
+    int32_t span_us;
     uint32_t i, m = 0;
     for (i = 0; i < count; i++) {
         const gs_sample *s = gs_ring_at(ring, first + i);
@@ -1761,9 +1763,10 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     wn->count = count;
     wn->m = m;
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
-    wn->tscale_us = t_max - t_min;  /* held samples are less than 2^31 us apart */
-    wn->t0_us = t_min + (wn->tscale_us >> 1);  /* a shift: no 64-bit division */
-    wn->tscale_us_r = gs_time_span_us(wn->tscale_us, 0);
+    span_us = (int32_t)(t_max - t_min);  /* held samples are less than 2^31 us apart */
+    wn->t0_us = t_min + (span_us >> 1);  /* (> 0: a shift halves it) */
+    wn->tscale_us_r = (gs_real)span_us;  /* gs_time_span_us of it, which does not saturate */
+    wn->tscale_s = gs_time_span32_s(span_us);
     for (i = 0; GS_FIT_FAST && i < count && i < GS_FIT_CACHE; i++) {
         if (!win_usable(wn, i, &wn->cache[i])) {
             wn->cache[i].w = 0.0f;
