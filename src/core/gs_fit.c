@@ -1732,7 +1732,6 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
 static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint32_t count)
 {
     const gs_sample *lo, *hi; /* the first and the last usable sample (set once m > 0) */
-    int64_t t_min, t_max;  /* absolute times */
     int32_t span_us;
     uint32_t i, m = 0;
     for (i = 0; i < count; i++) {
@@ -1752,10 +1751,10 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     if (m < 3) {
         return GS_EINVAL;
     }
-    /* the ring's times never decrease: the first usable is the earliest, the last the latest */
-    t_min = gs_ring_sample_t_us(ring, lo);
-    t_max = gs_ring_sample_t_us(ring, hi);
-    if (!(t_max > t_min)) {
+    /* the ring's times never decrease: the first usable is the earliest, the last the latest,
+     * less than 2^31 us later (held samples): their 32-bit times' difference is exact */
+    span_us = (int32_t)(hi->t_us - lo->t_us);
+    if (!(span_us > 0)) {
         return GS_EINVAL;
     }
     wn->ring = ring;
@@ -1763,8 +1762,7 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     wn->count = count;
     wn->m = m;
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
-    span_us = (int32_t)(t_max - t_min);  /* held samples are less than 2^31 us apart */
-    wn->t0_us = t_min + (span_us >> 1);  /* (> 0: a shift halves it) */
+    wn->t0_us = gs_ring_sample_t_us(ring, lo) + (span_us >> 1);  /* (> 0: a shift halves it) */
     wn->tscale_us_r = (gs_real)span_us;  /* gs_time_span_us of it, which does not saturate */
     wn->tscale_s = gs_time_span32_s(span_us);
     for (i = 0; GS_FIT_FAST && i < count && i < GS_FIT_CACHE; i++) {
