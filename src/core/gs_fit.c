@@ -171,8 +171,9 @@ void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
 }
 
-/* No curve yet: the result's centre and count, every value NaN (one copy for both callers) */
-static NOINLINE void empty_result(gs_fit_result *out, int64_t t0_us, uint32_t n)
+/* No curve yet: the result's count and centre, every value NaN (one copy for both callers;
+ * the count before the 64-bit centre keeps every argument in a register on a 32-bit core) */
+static NOINLINE void empty_result(gs_fit_result *out, uint32_t n, int64_t t0_us)
 {
     const gs_real nan = (gs_real)NAN;
     out->t0_us = t0_us;
@@ -206,7 +207,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     if (!f || !out) {
         return GS_EINVAL;
     }
-    empty_result(out, f->t0_us, f->n);
+    empty_result(out, f->n, f->t0_us);
     if (f->n < 3) {
         return GS_EINVAL;
     }
@@ -1832,7 +1833,7 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (!out) {
         return GS_EINVAL;
     }
-    empty_result(out, GS_T_NONE, 0);
+    empty_result(out, 0, GS_T_NONE);
     if (!ring || !keep) {
         return GS_EINVAL; /* (an empty window is refused by win_open: fewer than 3 usable samples) */
     }
