@@ -1541,49 +1541,6 @@ static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
     return worst;
 }
 
-/* Tukey biweight IRLS from a start; *fin (not start) receives the converged curve. */
-static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
-                           gs_fit_result *out, gs_par *fin)
-{
-    gs_par next;
-    gs_real med, scale;
-    int it;
-    gs_status st;
-    bool settled;
-    *fin = *start;
-    for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
-        med = median_resid(wn, fin);
-        /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
-        scale = GS_FIT_MAD_K * med;
-        if (!(scale >= floor_px)) {
-            scale = floor_px;
-        }
-        /* the median just computed the residuals from fin that the weights need */
-#if GS_FIT_FAST
-        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, NULL, wn->r2);
-        if (st != GS_OK) {
-            return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
-        }
-#else
-        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, NULL);
-        if (st != GS_OK) {
-            return st;
-        }
-#endif
-        /* Settled when the curve moves by far less than the noise. */
-        settled = par_max_shift_px(fin, &next) <= GS_R(1e-6) * scale;
-        *fin = next;
-        if (settled) {
-            break;
-        }
-    }
-#if GS_FIT_FAST
-    return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
-#else
-    return GS_OK;
-#endif
-}
-
 /* Robust loss of a curve: prior-weighted Tukey rho at the noise floor's cut-off
  * (1 for a rejected sample), comparable between two candidate solutions. */
 static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
@@ -1628,13 +1585,52 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
     return loss;
 }
 
+/* Tukey biweight IRLS from a start, its flags and result to keep and out: the robust loss
+ * of the curve it settles on (tukey_loss), infinite when a reweighting leaves no fit. */
+static gs_real irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
+                         gs_fit_result *out)
+{
+    gs_par fin = *start, next;
+    gs_real med, scale;
+    int it;
+    gs_status st = GS_OK;
+    bool settled;
+    for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
+        med = median_resid(wn, &fin);
+        /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
+        scale = GS_FIT_MAD_K * med;
+        if (!(scale >= floor_px)) {
+            scale = floor_px;
+        }
+        /* the median just computed the residuals from fin that the weights need */
+#if GS_FIT_FAST
+        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, NULL, wn->r2);
+#else
+        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, NULL);
+#endif
+        if (st != GS_OK) {
+            break;
+        }
+        /* Settled when the curve moves by far less than the noise. */
+        settled = par_max_shift_px(&fin, &next) <= GS_R(1e-6) * scale;
+        fin = next;
+        if (settled) {
+            break;
+        }
+    }
+#if GS_FIT_FAST
+    st = solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
+#endif
+    return st == GS_OK ? tukey_loss(wn, &fin, floor_px) : (gs_real)INFINITY;
+}
+
 /* IRLS from two starts, the least-median-of-squares one (survives many gross
  * outliers) and the plain weighted fit (on clean data a few samples can fit a
  * chance subset better than all of them): the smaller robust loss wins. */
 static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
 {
     enum { LMS, PLAIN, N_STARTS };
-    gs_par start[N_STARTS], fin;
+    gs_par start[N_STARTS];
     gs_real med, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
     bool have[N_STARTS];
     int k;
@@ -1647,15 +1643,15 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     bool saved = false;
     /* the plain start first: the LMS run, which wins more often, leaves keep and out as its result */
     for (k = PLAIN; k >= LMS; k--) {
-        if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
-            loss[k] = tukey_loss(wn, &fin, floor_px);
-            if (GS_FIT_FAST && k == PLAIN && have[LMS] && wn->count <= GS_FIT_CACHE) {
-                for (i = 0; i < words; i++) {
-                    plain_keep[i] = keep[i];
-                }
-                plain_out = *out;
-                saved = true;
+        if (have[k]) {
+            loss[k] = irls_from(wn, &start[k], floor_px, keep, out);
+        }
+        if (GS_FIT_FAST && k == PLAIN && loss[PLAIN] < (gs_real)INFINITY && have[LMS] && wn->count <= GS_FIT_CACHE) {
+            for (i = 0; i < words; i++) {
+                plain_keep[i] = keep[i];
             }
+            plain_out = *out;
+            saved = true;
         }
     }
     /* (a run's loss is finite: each of at most count terms is at most its weight, <= 1) */
@@ -1674,8 +1670,9 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
         return GS_OK;
     }
     /* the plain run won: run it again so keep and out hold its weights (where no LMS start ran
-     * after it they hold them already: the same deterministic run, the same OK) */
-    return irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin);
+     * after it they hold them already: the same deterministic run, the same finite loss) */
+    (void)irls_from(wn, &start[PLAIN], floor_px, keep, out);
+    return GS_OK;
 }
 
 static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
