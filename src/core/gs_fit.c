@@ -345,6 +345,7 @@ typedef struct {
     uint64_t first;
     uint32_t count;
     uint32_t m; /* usable samples in the window */
+    uint32_t *keep;           /* the caller's flags, a bit per sample (gs_fit_robust) */
     int64_t t0_us;            /* the window's centre */
     gs_real tscale_us_r;      /* its length in us (> 0, below the ring's 2^31 us span; exact below 2^24 us in float) */
     gs_real tscale_s;         /* the same in seconds: its fits' scale (gs_time_span_s) */
@@ -1341,9 +1342,10 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
  * In double the normal equations (sums about model, when there is one) lose nothing
  * and cost a fraction of the Givens rows; in float (the firmware) the rows keep the
  * fit accurate in single precision. */
-static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, uint32_t *keep,
-                            gs_par *p, gs_fit_result *out, const gs_real *r2)
+static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, gs_par *p,
+                            gs_fit_result *out, const gs_real *r2)
 {
+    uint32_t *keep = wn->keep;
     gs_fit f;
     gs_wsums a;
     gs_par base;
@@ -1585,10 +1587,9 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
     return loss;
 }
 
-/* Tukey biweight IRLS from a start, its flags and result to keep and out: the robust loss
+/* Tukey biweight IRLS from a start, its flags and result to wn->keep and out: the robust loss
  * of the curve it settles on (tukey_loss), infinite when a reweighting leaves no fit. */
-static gs_real irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
-                         gs_fit_result *out)
+static gs_real irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, gs_fit_result *out)
 {
     gs_par fin = *start, next;
     gs_real med, scale;
@@ -1604,9 +1605,9 @@ static gs_real irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px
         }
         /* the median just computed the residuals from fin that the weights need */
 #if GS_FIT_FAST
-        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, NULL, wn->r2);
+        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, &next, NULL, wn->r2);
 #else
-        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, NULL);
+        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, &next, out, NULL);
 #endif
         if (st != GS_OK) {
             break;
@@ -1627,15 +1628,16 @@ static gs_real irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px
 /* IRLS from two starts, the least-median-of-squares one (survives many gross
  * outliers) and the plain weighted fit (on clean data a few samples can fit a
  * chance subset better than all of them): the smaller robust loss wins. */
-static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
+static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, gs_fit_result *out)
 {
+    uint32_t *keep = wn->keep;
     enum { LMS, PLAIN, N_STARTS };
     gs_par start[N_STARTS];
     gs_real med, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
     bool have[N_STARTS];
     int k;
     have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
-    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out, NULL) == GS_OK;
+    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), &start[PLAIN], out, NULL) == GS_OK;
     /* a fast build keeps the plain run's flags and result (a few words for windows the cache holds) */
     uint32_t plain_keep[GS_FIT_FAST ? GS_FIT_CACHE / 32u : 1u];
     gs_fit_result plain_out;
@@ -1644,7 +1646,7 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     /* the plain start first: the LMS run, which wins more often, leaves keep and out as its result */
     for (k = PLAIN; k >= LMS; k--) {
         if (have[k]) {
-            loss[k] = irls_from(wn, &start[k], floor_px, keep, out);
+            loss[k] = irls_from(wn, &start[k], floor_px, out);
         }
         if (GS_FIT_FAST && k == PLAIN && loss[PLAIN] < (gs_real)INFINITY && have[LMS] && wn->count <= GS_FIT_CACHE) {
             for (i = 0; i < words; i++) {
@@ -1671,11 +1673,11 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     }
     /* the plain run won: run it again so keep and out hold its weights (where no LMS start ran
      * after it they hold them already: the same deterministic run, the same finite loss) */
-    (void)irls_from(wn, &start[PLAIN], floor_px, keep, out);
+    (void)irls_from(wn, &start[PLAIN], floor_px, out);
     return GS_OK;
 }
 
-static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
+static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, gs_fit_result *out)
 {
     uint32_t state = GS_FIT_SEED_RANSAC;
     gs_real thr = GS_R(3.0) * floor_px;
@@ -1722,7 +1724,7 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
     if (!found) {
         return GS_EINVAL;
     }
-    return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out, NULL);
+    return window_fit(wn, &best, W_INLIER, thr, NULL, out, NULL);
 }
 
 /* Opens the window [first, first+count): GS_EINVAL when a sample is no longer held
@@ -1785,17 +1787,16 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     return GS_OK;
 }
 
-static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, uint32_t *keep,
-                            gs_fit_result *out)
+static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, gs_fit_result *out)
 {
     gs_real floor_px = (gs_finite_f(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
     switch (method) {
     case GS_FIT_PLAIN:
-        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out, NULL);
+        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), NULL, out, NULL);
     case GS_FIT_IRLS:
-        return fit_irls(wn, wn->m, floor_px, keep, out);
+        return fit_irls(wn, wn->m, floor_px, out);
     case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
-        return GS_WITH_RANSAC ? fit_ransac(wn, wn->m, floor_px, keep, out) : GS_EINVAL;
+        return GS_WITH_RANSAC ? fit_ransac(wn, wn->m, floor_px, out) : GS_EINVAL;
     }
     return GS_EINVAL;
 }
@@ -1834,9 +1835,10 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (!ring || !keep) {
         return GS_EINVAL; /* (an empty window is refused by win_open: fewer than 3 usable samples) */
     }
+    wn.keep = keep;
     st = win_open(&wn, ring, first, count);
     if (st == GS_OK) {
-        st = fit_window(&wn, method, min_scale_px, keep, out);
+        st = fit_window(&wn, method, min_scale_px, out);
     }
     if (st != GS_OK) {
         for (i = 0; i < count; i++) {
