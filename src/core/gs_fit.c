@@ -68,8 +68,8 @@ typedef long long gs_v2l __attribute__((vector_size(16))); /* a comparison's lan
 
 static const gs_real rad_to_deg = GS_R(57.29577951308232);
 
-/* An empty fit at a valid centre and scale (> 0 us): all sums and R zero (all-zero bits are +0.0). */
-static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
+/* An empty fit at a valid centre and scale (> 0 s): all sums and R zero (all-zero bits are +0.0). */
+static void fit_start(gs_fit *f, int64_t t0_us, gs_real tscale_s)
 {
 #if GS_FIT_FAST
     /* field by field: a few vector stores where the memset of the whole is a rep stos */
@@ -83,11 +83,11 @@ static void fit_start(gs_fit *f, int64_t t0_us, int64_t tscale_us)
     f->ssr_x = f->ssr_y = f->sum_w = GS_R(0.0);
     f->n = 0;
     f->t0_us = t0_us;
-    f->tscale_s = gs_time_span_s(tscale_us, 0);
+    f->tscale_s = tscale_s;
 #else
     memset(f, 0, sizeof *f);
     f->t0_us = t0_us;
-    f->tscale_s = gs_time_span_s(tscale_us, 0);
+    f->tscale_s = tscale_s;
 #endif
 }
 
@@ -97,7 +97,7 @@ void gs_fit_init(gs_fit *f, int64_t t0_us, int64_t tscale_us)
         return;
     }
     /* A bad scale would make every tau NaN; 1 s keeps the fit usable. */
-    fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, tscale_us > 0 ? tscale_us : GS_US_PER_S);
+    fit_start(f, gs_time_ok(t0_us) ? t0_us : 0, gs_time_span_s(tscale_us > 0 ? tscale_us : GS_US_PER_S, 0));
 }
 
 /* The centred, scaled time of t_us: the exact integer span over the scale, both in microseconds. */
@@ -171,8 +171,9 @@ void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);
 }
 
-/* No curve yet: the result's centre and count, every value NaN (one copy for both callers) */
-static NOINLINE void empty_result(gs_fit_result *out, int64_t t0_us, uint32_t n)
+/* No curve yet: the result's count and centre, every value NaN (one copy for both callers;
+ * the count before the 64-bit centre keeps every argument in a register on a 32-bit core) */
+static NOINLINE void empty_result(gs_fit_result *out, uint32_t n, int64_t t0_us)
 {
     const gs_real nan = (gs_real)NAN;
     out->t0_us = t0_us;
@@ -206,7 +207,7 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
     if (!f || !out) {
         return GS_EINVAL;
     }
-    empty_result(out, f->t0_us, f->n);
+    empty_result(out, f->n, f->t0_us);
     if (f->n < 3) {
         return GS_EINVAL;
     }
@@ -344,8 +345,10 @@ typedef struct {
     uint64_t first;
     uint32_t count;
     uint32_t m; /* usable samples in the window */
-    int64_t t0_us, tscale_us; /* the window's centre and length (> 0, below the ring's 2^31 us span) */
-    gs_real tscale_us_r;      /* tscale_us, exact (below 2^24 us where gs_real is float) */
+    uint32_t *keep;           /* the caller's flags, a bit per sample (gs_fit_robust) */
+    int64_t t0_us;            /* the window's centre */
+    gs_real tscale_us_r;      /* its length in us (> 0, below the ring's 2^31 us span; exact below 2^24 us in float) */
+    gs_real tscale_s;         /* the same in seconds: its fits' scale (gs_time_span_s) */
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
     gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
@@ -439,8 +442,9 @@ static bool win_usable(const gs_win *wn, uint32_t i, gs_fsamp *out)
     if (!s || !sample_usable(s)) {
         return false;
     }
-    /* the span from the centre is exact; the centred, unit-length tau fits a float */
-    out->tau = fit_tau(gs_ring_sample_t_us(wn->ring, s), wn->t0_us, wn->tscale_us_r);
+    /* the span from the centre, exact from the 32-bit times (a usable sample lies in the
+     * window, which spans less than 2^31 us: win_open); the centred, unit-length tau fits a float */
+    out->tau = (gs_real)(int32_t)(s->t_us - (uint32_t)(uint64_t)wn->t0_us) / wn->tscale_us_r;
     out->xy_px[0] = s->x_px;
     out->xy_px[1] = s->y_px;
     out->w = gs_sample_w(s);
@@ -1338,9 +1342,10 @@ GS_NO_SLP static void wsums_cached(const gs_win *wn, const gs_par *model, const 
  * In double the normal equations (sums about model, when there is one) lose nothing
  * and cost a fraction of the Givens rows; in float (the firmware) the rows keep the
  * fit accurate in single precision. */
-static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, uint32_t *keep,
-                            gs_par *p, gs_fit_result *out, const gs_real *r2)
+static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, gs_real cut, gs_par *p,
+                            gs_fit_result *out, const gs_real *r2)
 {
+    uint32_t *keep = wn->keep;
     gs_fit f;
     gs_wsums a;
     gs_par base;
@@ -1355,7 +1360,7 @@ static gs_status window_fit(const gs_win *wn, const gs_par *model, w_mode mode, 
         }
     }
 #endif
-    fit_start(&f, wn->t0_us, wn->tscale_us);  /* the scale positive */
+    fit_start(&f, wn->t0_us, wn->tscale_s);
 #if GS_FIT_FAST
     if (!GS_REAL_IS_FLOAT && wn->count <= GS_FIT_CACHE) {
         wsums_cached(wn, model, &base, mode, cut, keep, r2, &a); /* sets every sum */
@@ -1538,49 +1543,6 @@ static gs_real par_max_shift_px(const gs_par *a, const gs_par *b)
     return worst;
 }
 
-/* Tukey biweight IRLS from a start; *fin (not start) receives the converged curve. */
-static gs_status irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, uint32_t *keep,
-                           gs_fit_result *out, gs_par *fin)
-{
-    gs_par next;
-    gs_real med, scale;
-    int it;
-    gs_status st;
-    bool settled;
-    *fin = *start;
-    for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
-        med = median_resid(wn, fin);
-        /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
-        scale = GS_FIT_MAD_K * med;
-        if (!(scale >= floor_px)) {
-            scale = floor_px;
-        }
-        /* the median just computed the residuals from fin that the weights need */
-#if GS_FIT_FAST
-        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, NULL, wn->r2);
-        if (st != GS_OK) {
-            return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
-        }
-#else
-        st = window_fit(wn, fin, W_TUKEY, GS_FIT_TUKEY_C * scale, keep, &next, out, NULL);
-        if (st != GS_OK) {
-            return st;
-        }
-#endif
-        /* Settled when the curve moves by far less than the noise. */
-        settled = par_max_shift_px(fin, &next) <= GS_R(1e-6) * scale;
-        *fin = next;
-        if (settled) {
-            break;
-        }
-    }
-#if GS_FIT_FAST
-    return solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
-#else
-    return GS_OK;
-#endif
-}
-
 /* Robust loss of a curve: prior-weighted Tukey rho at the noise floor's cut-off
  * (1 for a rejected sample), comparable between two candidate solutions. */
 static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
@@ -1625,18 +1587,57 @@ static gs_real tukey_loss(const gs_win *wn, const gs_par *p, gs_real floor_px)
     return loss;
 }
 
+/* Tukey biweight IRLS from a start, its flags and result to wn->keep and out: the robust loss
+ * of the curve it settles on (tukey_loss), infinite when a reweighting leaves no fit. */
+static gs_real irls_from(const gs_win *wn, const gs_par *start, gs_real floor_px, gs_fit_result *out)
+{
+    gs_par fin = *start, next;
+    gs_real med, scale;
+    int it;
+    gs_status st = GS_OK;
+    bool settled;
+    for (it = 0; it < GS_FIT_IRLS_MAX_ITER; it++) {
+        med = median_resid(wn, &fin);
+        /* Residuals are deviations from the model (zero centred), so the MAD is the median norm. */
+        scale = GS_FIT_MAD_K * med;
+        if (!(scale >= floor_px)) {
+            scale = floor_px;
+        }
+        /* the median just computed the residuals from fin that the weights need */
+#if GS_FIT_FAST
+        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, &next, NULL, wn->r2);
+#else
+        st = window_fit(wn, &fin, W_TUKEY, GS_FIT_TUKEY_C * scale, &next, out, NULL);
+#endif
+        if (st != GS_OK) {
+            break;
+        }
+        /* Settled when the curve moves by far less than the noise. */
+        settled = par_max_shift_px(&fin, &next) <= GS_R(1e-6) * scale;
+        fin = next;
+        if (settled) {
+            break;
+        }
+    }
+#if GS_FIT_FAST
+    st = solve_par(&wn->last->f, out, NULL, wn->last->based ? &wn->last->base : NULL);
+#endif
+    return st == GS_OK ? tukey_loss(wn, &fin, floor_px) : (gs_real)INFINITY;
+}
+
 /* IRLS from two starts, the least-median-of-squares one (survives many gross
  * outliers) and the plain weighted fit (on clean data a few samples can fit a
  * chance subset better than all of them): the smaller robust loss wins. */
-static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
+static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, gs_fit_result *out)
 {
+    uint32_t *keep = wn->keep;
     enum { LMS, PLAIN, N_STARTS };
-    gs_par start[N_STARTS], fin;
+    gs_par start[N_STARTS];
     gs_real med, loss[N_STARTS] = {(gs_real)INFINITY, (gs_real)INFINITY};
     bool have[N_STARTS];
     int k;
     have[LMS] = lmeds_start(wn, m, &start[LMS], &med);
-    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, &start[PLAIN], out, NULL) == GS_OK;
+    have[PLAIN] = window_fit(wn, NULL, W_PRIOR, GS_R(0.0), &start[PLAIN], out, NULL) == GS_OK;
     /* a fast build keeps the plain run's flags and result (a few words for windows the cache holds) */
     uint32_t plain_keep[GS_FIT_FAST ? GS_FIT_CACHE / 32u : 1u];
     gs_fit_result plain_out;
@@ -1644,15 +1645,15 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
     bool saved = false;
     /* the plain start first: the LMS run, which wins more often, leaves keep and out as its result */
     for (k = PLAIN; k >= LMS; k--) {
-        if (have[k] && irls_from(wn, &start[k], floor_px, keep, out, &fin) == GS_OK) {
-            loss[k] = tukey_loss(wn, &fin, floor_px);
-            if (GS_FIT_FAST && k == PLAIN && have[LMS] && wn->count <= GS_FIT_CACHE) {
-                for (i = 0; i < words; i++) {
-                    plain_keep[i] = keep[i];
-                }
-                plain_out = *out;
-                saved = true;
+        if (have[k]) {
+            loss[k] = irls_from(wn, &start[k], floor_px, out);
+        }
+        if (GS_FIT_FAST && k == PLAIN && loss[PLAIN] < (gs_real)INFINITY && have[LMS] && wn->count <= GS_FIT_CACHE) {
+            for (i = 0; i < words; i++) {
+                plain_keep[i] = keep[i];
             }
+            plain_out = *out;
+            saved = true;
         }
     }
     /* (a run's loss is finite: each of at most count terms is at most its weight, <= 1) */
@@ -1670,11 +1671,13 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, uint32
         *out = plain_out;
         return GS_OK;
     }
-    /* the plain run won: run it again (when the LMS one ran after it) so keep and out hold its weights */
-    return have[LMS] ? irls_from(wn, &start[PLAIN], floor_px, keep, out, &fin) : GS_OK;
+    /* the plain run won: run it again so keep and out hold its weights (where no LMS start ran
+     * after it they hold them already: the same deterministic run, the same finite loss) */
+    (void)irls_from(wn, &start[PLAIN], floor_px, out);
+    return GS_OK;
 }
 
-static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint32_t *keep, gs_fit_result *out)
+static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, gs_fit_result *out)
 {
     uint32_t state = GS_FIT_SEED_RANSAC;
     gs_real thr = GS_R(3.0) * floor_px;
@@ -1721,14 +1724,15 @@ static gs_status fit_ransac(const gs_win *wn, uint32_t m, gs_real floor_px, uint
     if (!found) {
         return GS_EINVAL;
     }
-    return window_fit(wn, &best, W_INLIER, thr, keep, NULL, out, NULL);
+    return window_fit(wn, &best, W_INLIER, thr, NULL, out, NULL);
 }
 
 /* Opens the window [first, first+count): GS_EINVAL when a sample is no longer held
  * or fewer than 3 usable ones at distinct times remain. */
 static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint32_t count)
 {
-    int64_t t_min = 0, t_max = 0;  /* absolute times */
+    const gs_sample *lo, *hi; /* the first and the last usable sample (set once m > 0) */
+    int32_t span_us;
     uint32_t i, m = 0;
     for (i = 0; i < count; i++) {
         const gs_sample *s = gs_ring_at(ring, first + i);
@@ -1737,15 +1741,20 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
             return GS_EINVAL;
         }
         if (sample_usable(s)) {
-            /* the ring's times never decrease: the first usable is the earliest, the last the latest */
-            t_max = gs_ring_sample_t_us(ring, s);
             if (m == 0) {
-                t_min = t_max;
+                lo = s;
             }
+            hi = s;
             m++;
         }
     }
-    if (m < 3 || !(t_max > t_min)) {
+    if (m < 3) {
+        return GS_EINVAL;
+    }
+    /* the ring's times never decrease: the first usable is the earliest, the last the latest,
+     * less than 2^31 us later (held samples): their 32-bit times' difference is exact */
+    span_us = (int32_t)(hi->t_us - lo->t_us);
+    if (!(span_us > 0)) {
         return GS_EINVAL;
     }
     wn->ring = ring;
@@ -1753,9 +1762,9 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     wn->count = count;
     wn->m = m;
     /* Centred, unit-length tau keeps the basis well conditioned (and float-friendly). */
-    wn->tscale_us = t_max - t_min;  /* held samples are less than 2^31 us apart */
-    wn->t0_us = t_min + (wn->tscale_us >> 1);  /* a shift: no 64-bit division */
-    wn->tscale_us_r = gs_time_span_us(wn->tscale_us, 0);
+    wn->t0_us = gs_ring_sample_t_us(ring, lo) + (span_us >> 1);  /* (> 0: a shift halves it) */
+    wn->tscale_us_r = (gs_real)span_us;  /* gs_time_span_us of it, which does not saturate */
+    wn->tscale_s = gs_time_span32_s(span_us);
     for (i = 0; GS_FIT_FAST && i < count && i < GS_FIT_CACHE; i++) {
         if (!win_usable(wn, i, &wn->cache[i])) {
             wn->cache[i].w = 0.0f;
@@ -1778,17 +1787,16 @@ static gs_status win_open(gs_win *wn, const gs_ring *ring, uint64_t first, uint3
     return GS_OK;
 }
 
-static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, uint32_t *keep,
-                            gs_fit_result *out)
+static gs_status fit_window(const gs_win *wn, gs_fit_method method, float min_scale_px, gs_fit_result *out)
 {
     gs_real floor_px = (gs_finite_f(min_scale_px) && min_scale_px > 0.0f) ? (gs_real)min_scale_px : GS_FIT_TINY_SCALE_PX;
     switch (method) {
     case GS_FIT_PLAIN:
-        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), keep, NULL, out, NULL);
+        return window_fit(wn, NULL, W_PRIOR, GS_R(0.0), NULL, out, NULL);
     case GS_FIT_IRLS:
-        return fit_irls(wn, wn->m, floor_px, keep, out);
+        return fit_irls(wn, wn->m, floor_px, out);
     case GS_FIT_RANSAC: /* unknown where left out of the build (gs_features.h) */
-        return GS_WITH_RANSAC ? fit_ransac(wn, wn->m, floor_px, keep, out) : GS_EINVAL;
+        return GS_WITH_RANSAC ? fit_ransac(wn, wn->m, floor_px, out) : GS_EINVAL;
     }
     return GS_EINVAL;
 }
@@ -1823,13 +1831,14 @@ gs_status gs_fit_robust(const gs_ring *ring, uint64_t first, uint32_t count, gs_
     if (!out) {
         return GS_EINVAL;
     }
-    empty_result(out, GS_T_NONE, 0);
+    empty_result(out, 0, GS_T_NONE);
     if (!ring || !keep) {
         return GS_EINVAL; /* (an empty window is refused by win_open: fewer than 3 usable samples) */
     }
+    wn.keep = keep;
     st = win_open(&wn, ring, first, count);
     if (st == GS_OK) {
-        st = fit_window(&wn, method, min_scale_px, keep, out);
+        st = fit_window(&wn, method, min_scale_px, out);
     }
     if (st != GS_OK) {
         for (i = 0; i < count; i++) {

@@ -21,15 +21,54 @@ static inline double gs_min_d(double x, double y) { return x < y ? x : y; }
 static inline double gs_max_d(double x, double y) { return x > y ? x : y; }
 #endif
 
+/* *a, *b in ascending order: gs_min_*(*b, *a) and gs_max_*(*a, *b), so a NaN leaves both */
+#ifdef __OPTIMIZE_SIZE__
+/* (a swap on one compare: the min and max would compare the pair twice) */
+static inline void gs_order_f(float *a, float *b)
+{
+    if (*a > *b) {
+        float t = *a;
+        *a = *b;
+        *b = t;
+    }
+}
+
+static inline void gs_order_d(double *a, double *b)
+{
+    if (*a > *b) {
+        double t = *a;
+        *a = *b;
+        *b = t;
+    }
+}
+#else
+/* (no branch for noisy data to mispredict) */
+static inline void gs_order_f(float *a, float *b)
+{
+    float lo = gs_min_f(*b, *a);
+    *b = gs_max_f(*a, *b);
+    *a = lo;
+}
+
+static inline void gs_order_d(double *a, double *b)
+{
+    double lo = gs_min_d(*b, *a);
+    *b = gs_max_d(*a, *b);
+    *a = lo;
+}
+#endif
+
 /* the median of three (a NaN gives what a compare-and-swap sort of a, b, c would) */
 static inline float gs_med3_f(float a, float b, float c)
 {
-    return gs_max_f(gs_min_f(b, a), gs_min_f(c, gs_max_f(a, b)));
+    gs_order_f(&a, &b);
+    return gs_max_f(a, gs_min_f(c, b));
 }
 
 static inline double gs_med3_d(double a, double b, double c)
 {
-    return gs_max_d(gs_min_d(b, a), gs_min_d(c, gs_max_d(a, b)));
+    gs_order_d(&a, &b);
+    return gs_max_d(a, gs_min_d(c, b));
 }
 
 #endif
