@@ -50,7 +50,7 @@ typedef struct {
 
 typedef struct {
     uint32_t t_us[GS_FEET_HIST];/* frame times of the history slots, microseconds modulo 2^32 */
-    uint32_t n;                 /* frames examined */
+    uint32_t n;                 /* frames examined, counted up to the GS_FEET_HIST - 2 held */
     uint8_t pending;            /* the newest frame waits for the next (outlier test) */
     int64_t pend_t_us;          /* its time */
     float pend_size_px;         /* its body size */

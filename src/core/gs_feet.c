@@ -79,7 +79,8 @@ static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float fro
 static unsigned slot(uint32_t back) { return back + WAIT_SLOTS; }
 
 /* frames held in the history (two slots are the pending frame and the one after it) */
-static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - WAIT_SLOTS ? ft->n : GS_FEET_HIST - WAIT_SLOTS; }
+#define HELD_MAX (GS_FEET_HIST - WAIT_SLOTS)
+static uint32_t held(const gs_feet *ft) { return ft->n; }
 
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static ALWAYS_INLINE uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
@@ -321,7 +322,7 @@ static void process_pending(gs_feet *ft, const float *next)
         float da = b - a, dc = b - c;  /* (a - b is -(b - a) exactly) */
         if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
     }
-    ft->n++;
+    if (ft->n < HELD_MAX) ft->n++;
     /* the history one slot older */
     for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->t_us[k] = ft->t_us[k - 1u];
     for (int p = 0; p < GS_FEET_POINTS; p++)
