@@ -254,7 +254,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (RECROSS) f->falling = v2 < -FALL_REL * size_px;  /* (read for recrossings only) */
     float vf = speed(ft, f, 2);  /* (the impact may fall inside the last falling interval) */
     if (!(vf < v1)) vf = v1;
-    if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
+    /* (stopped against v1 is stopped against vf too: vf <= v1 once vf is a fall) */
+    if (vf < -FAST_REL * size_px && v2 > v1 / STOP_RATIO &&
         (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
         int64_t tc;
         if (landing_us(ft, f, u + d, margin, size_px, &tc)) {
