@@ -286,7 +286,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
     }
     bool resting = st && m <= f->rest_px + margin;  /* still throughout, at its level */
-    if (st && (!fin(f->rest_px) || m < f->rest_px - 2.0f * margin || m > f->rest_px + 3.0f * d + margin)) {
+    /* (outside the band around the floor, or no floor: NaN compares false) */
+    if (st && !(m >= f->rest_px - 2.0f * margin && m <= f->rest_px + 3.0f * d + margin)) {
         f->rest_px = m;  /* a new floor */
         f->rest_n = 0;
         resting = true;
