@@ -52,7 +52,7 @@ typedef struct {
     uint32_t t_us[GS_FEET_HIST];/* frame times of the history slots, microseconds modulo 2^32 */
     uint32_t n;                 /* frames examined, counted up to the GS_FEET_HIST - 2 held */
     uint8_t pending;            /* the newest frame waits for the next (outlier test) */
-    int64_t pend_t_us;          /* its time */
+    int64_t pend_t_us;          /* its time (once examined, t_last_us; GS_T_NONE before a frame) */
     float pend_size_px;         /* its body size */
     int64_t t_last_us, t_prev_us; /* the newest frame's time and the one before, whole */
     int64_t unseen_us;          /* the latest frame with a point missing, GS_T_NONE none */

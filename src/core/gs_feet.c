@@ -58,7 +58,7 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
     ft->up_y = -1.0f;
     ft->delta_rel = delta_rel;
     ft->stop_touch = !RECROSS || (STOPS && stop_touch);
-    ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
+    ft->pend_t_us = ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         reset_track(&ft->pt[p]);
         for (int k = 0; k < GS_FEET_LOG; k++) ft->pt[p].lift[k].t_us = ft->pt[p].touch[k].t_us = GS_T_NONE;
@@ -348,8 +348,8 @@ void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
                   const float y_px[GS_FEET_POINTS], gs_real up_x, gs_real up_y, gs_real size_px)
 {
     if (!(size_px > 0) || !(size_px < INFINITY) || t_us == GS_T_NONE) return;
-    int64_t last = ft->pending ? ft->pend_t_us : ft->t_last_us;
-    if (t_us <= last) return;  /* (last GS_T_NONE, the lowest int64: t_us, not GS_T_NONE, passes) */
+    /* (pend_t_us: the newest frame pushed, pending or examined; GS_T_NONE, the lowest int64, before one) */
+    if (t_us <= ft->pend_t_us) return;
     float ux = (float)up_x, uy = (float)up_y;
     if (!(ux * ft->up_x + uy * ft->up_y >= UP_COS_MIN)) {
         /* heights along another direction: the levels go, the logged events stay */
