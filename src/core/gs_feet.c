@@ -319,11 +319,12 @@ static void process_pending(gs_feet *ft, const float *next)
 {
     unsigned s = WAIT_SLOTS - 1u;  /* the pending frame's */
     float size = ft->pend_size_px, spike = SPIKE_REL * size;
-    for (int p = 0; next && ft->n > 0 && p < GS_FEET_POINTS; p++) {
-        float a = u_at(&ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
-        float da = b - a, dc = b - c;  /* (a - b is -(b - a) exactly) */
-        if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
-    }
+    if (next && ft->n > 0)
+        for (int p = 0; p < GS_FEET_POINTS; p++) {
+            float a = u_at(&ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
+            float da = b - a, dc = b - c;  /* (a - b is -(b - a) exactly) */
+            if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
+        }
     if (ft->n < HELD_MAX) ft->n++;
     /* the history one slot older */
     for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->t_us[k] = ft->t_us[k - 1u];
