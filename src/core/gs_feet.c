@@ -192,14 +192,14 @@ static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
 
 /* still: the (median) height u_now moved less than STILL_REL x size per second against the
  * median about LAG_US back (the oldest held when the history is shorter): a detector's lone
- * jittery frame, there or here, is no motion */
-static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_px)
+ * jittery frame, there or here, is no motion, nor is the point's own jitter (jitter_px) */
+static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_px, float jitter_px)
 {
     uint32_t n = held(ft), b = 1;
     if (n < 2) return false;
     while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
     float du = u_now - med3_at(ft, f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
-    if (NOISE_K * f->noise_px > lim) lim = NOISE_K * f->noise_px;  /* (jitter is no motion) */
+    if (jitter_px > lim) lim = jitter_px;  /* (jitter is no motion) */
     return fabsf(du) < lim;  /* false for NaN (fabsf: a mask, no branch) */
 }
 
@@ -219,8 +219,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (!fin(u)) return;  /* a missing frame changes nothing */
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);  /* (nothing below changes the history) */
     /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */
-    float margin = MARGIN_REL * size_px;
-    if (NOISE_K * f->noise_px > margin) margin = NOISE_K * f->noise_px;
+    float margin = MARGIN_REL * size_px, jitter = NOISE_K * f->noise_px;
+    if (jitter > margin) margin = jitter;
     if (u < f->low_px) f->low_px = u;  /* (NaN before a lift: no change) */
     /* a floor holds the point: the frame after a stop stays at its level; after a recrossing
      * (ankles) the heel comes down onto that level, not past it */
@@ -279,7 +279,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
      * no step). A rest below it is a new floor, one far above it too (stepping up); a slow
      * rise in between (a heel or a toe rolling up before take-off) is leaving it */
     float m = med3_at(ft, f, 0);
-    bool st = still(ft, f, m, size_px);
+    bool st = still(ft, f, m, size_px, jitter);  /* (noise_px is learnt below) */
     if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
         float d2 = fabsf(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
         if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
