@@ -27,7 +27,7 @@
 typedef struct {
     int64_t t_us;              /* GS_T_NONE: empty */
     float level_px;            /* the floor it left (lift) or met (touch) */
-    float from_px;             /* touch: the floor it had rested on before */
+    float from_px;             /* touch: the floor it had rested on before (a lift's is not set) */
 } gs_feet_event;
 
 typedef struct {

@@ -65,13 +65,12 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
     }
 }
 
-/* the newest event first; from_px only for touches */
-static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float from_px)
+/* the newest event first (a lift's from_px is not read: only a touch's is set) */
+static void log_event(gs_feet_event *ev, int64_t t_us, float level_px)
 {
     memmove(ev + 1, ev, (GS_FEET_LOG - 1) * sizeof *ev);
     ev->t_us = t_us;
     ev->level_px = level_px;
-    ev->from_px = from_px;
 }
 
 /* slot of the frame `back` frames before the newest (0: the newest): the history moves
@@ -241,7 +240,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (f->armed && above && f->lift_pending) {
         int64_t tc;
         if (crossing_us(ft, f, lift_px, true, &tc)) {
-            log_event(f->lift, tc, f->rest_px, NAN);
+            log_event(f->lift, tc, f->rest_px);
             f->lifted = 1;
             f->low_px = u;
         }
@@ -259,7 +258,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
         int64_t tc;
         if (landing_us(ft, f, u + d, margin, size_px, &tc)) {
-            log_event(f->touch, tc, u, f->floor_px);
+            log_event(f->touch, tc, u);
+            f->touch[0].from_px = f->floor_px;
             f->touch_unsure = 1;
             f->lifted = 0;
         }
@@ -269,7 +269,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (RECROSS && !stop_touch && f->lifted && u <= back_px) {
         int64_t tc;
         if (crossing_us(ft, f, back_px, false, &tc)) {
-            log_event(f->touch, tc, f->floor_px, f->floor_px);
+            log_event(f->touch, tc, f->floor_px);
+            f->touch[0].from_px = f->floor_px;
             f->touch_unsure = 2;
             f->falling = 0;  /* the next frame tells */
         }
