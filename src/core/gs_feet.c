@@ -327,16 +327,16 @@ static void process_pending(gs_feet *ft, const float *next)
             if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
         }
     if (ft->n < HELD_MAX) ft->n++;
-    /* the history one slot older */
+    /* the history one slot older (each point's just before its step, which reads only its own) */
     for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->t_us[k] = ft->t_us[k - 1u];
-    for (int p = 0; p < GS_FEET_POINTS; p++)
-        for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->pt[p].u_px[k] = ft->pt[p].u_px[k - 1u];
     ft->t_prev_us = ft->t_last_us;
     ft->t_last_us = ft->pend_t_us;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
-        float u = u_at(&ft->pt[p], 0);  /* the pending frame, now the newest */
+        gs_foot *f = &ft->pt[p];
+        for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) f->u_px[k] = f->u_px[k - 1u];
+        float u = u_at(f, 0);  /* the pending frame, now the newest */
         if (!fin(u)) ft->unseen_us = ft->t_last_us;
-        point_step(ft, &ft->pt[p], ft->t_last_us, u, size);
+        point_step(ft, f, ft->t_last_us, u, size);
     }
     ft->pending = 0;
 }
