@@ -237,7 +237,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
      * (one is an outlier) */
     float lift_px = f->rest_px + d;  /* the lift level */
     bool above = u > lift_px + margin;
-    if (f->armed && above && f->lift_pending) {
+    if (above && f->lift_pending) {  /* (lift_pending only while armed) */
         int64_t tc;
         if (crossing_us(ft, f, lift_px, true, &tc)) {
             log_event(f->lift, tc, f->rest_px);
