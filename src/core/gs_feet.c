@@ -227,7 +227,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         if (u < f->touch[0].level_px - (RECROSS ? (float)f->touch_unsure * margin : margin)) {
             memmove(f->touch, f->touch + 1, (GS_FEET_LOG - 1) * sizeof f->touch[0]);  /* it fell on */
             f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
-            f->lifted = RECROSS && f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
+            /* (a recrossing it fell past: still in the air; a stop's touch cleared lifted) */
+            if (RECROSS) f->lifted = f->touch_unsure == 2;
             f->touch_unsure = 0;
         } else if (!RECROSS || f->touch_unsure == 1 || !(v2 < 0.0f)) {
             f->touch_unsure = 0;
