@@ -31,7 +31,8 @@ typedef struct {
 } gs_feet_event;
 
 typedef struct {
-    float u_px[GS_FEET_HIST];  /* heights along up, NaN missing (slot 2 + k: k frames before the newest examined) */
+    float u_px[GS_FEET_HIST];  /* heights along up, NaN missing (slot 2 + k: k frames before the newest examined;
+                                * NaN for k at or past the frames held) */
     float rest_px;             /* current floor level, NaN unknown */
     float floor_px;            /* the level it last rested on long enough (armed), NaN none */
     uint32_t rest_for_us;      /* how long it has rested so far (0: not resting) */

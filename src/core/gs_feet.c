@@ -205,7 +205,7 @@ static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_p
 /* speed over the interval ending `back` frames before the newest, px/s (NaN unknown) */
 static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
 {
-    if (back + 2 > held(ft)) return NAN;
+    /* (NaN unless both frames are held: the slots past the held frames are NaN; back <= 2) */
     uint32_t dt = age_us(ft, back + 1) - age_us(ft, back);
     return (u_at(f, back) - u_at(f, back + 1)) / ((float)dt * 1e-6f);
 }
