@@ -282,7 +282,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
      * rise in between (a heel or a toe rolling up before take-off) is leaving it */
     float m = med3_at(ft, f, 0);
     bool st = still(ft, f, m, size_px, jitter);  /* (noise_px is learnt below) */
-    if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
+    if (st) {  /* |second difference| of a still point: 1.954 sigma on average (NaN: fewer than 3 held) */
         float d2 = fabsf(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
         if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
         if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
