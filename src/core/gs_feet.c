@@ -180,10 +180,10 @@ static bool landing_us(const gs_feet *ft, const gs_foot *f, float L, float margi
 
 /* the median of the point's heights `back`, `back`+1 and `back`+2 frames before the newest
  * (a lone outlier does not move it); the height `back` alone when those are not all known */
-static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
+static float med3_at(const gs_foot *f, uint32_t back)
 {
     float a = u_at(f, back);
-    if (back + 3u > held(ft)) return a;
+    if (back + 3u > HELD_MAX) return a;  /* (within the history; past the held frames heights are NaN) */
     float b = u_at(f, back + 1u), c = u_at(f, back + 2u);
     if (!fin(a) || !fin(b) || !fin(c)) return a;
     return gs_med3_f(a, b, c);
@@ -197,7 +197,7 @@ static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_p
     uint32_t n = held(ft), b = 1;
     if (n < 2) return false;
     while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
-    float du = u_now - med3_at(ft, f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
+    float du = u_now - med3_at(f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
     if (jitter_px > lim) lim = jitter_px;  /* (jitter is no motion) */
     return fabsf(du) < lim;  /* false for NaN (fabsf: a mask, no branch) */
 }
@@ -280,7 +280,7 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* the floor level: what the point rests on at its lowest (median heights: an outlier is
      * no step). A rest below it is a new floor, one far above it too (stepping up); a slow
      * rise in between (a heel or a toe rolling up before take-off) is leaving it */
-    float m = med3_at(ft, f, 0);
+    float m = med3_at(f, 0);
     bool st = still(ft, f, m, size_px, jitter);  /* (noise_px is learnt below) */
     if (st) {  /* |second difference| of a still point: 1.954 sigma on average (NaN: fewer than 3 held) */
         float d2 = fabsf(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
