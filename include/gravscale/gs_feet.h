@@ -27,11 +27,12 @@
 typedef struct {
     int64_t t_us;              /* GS_T_NONE: empty */
     float level_px;            /* the floor it left (lift) or met (touch) */
-    float from_px;             /* touch: the floor it had rested on before */
+    float from_px;             /* touch: the floor it had rested on before (a lift's is not set) */
 } gs_feet_event;
 
 typedef struct {
-    float u_px[GS_FEET_HIST];  /* heights along up, NaN missing (slot 2 + k: k frames before the newest examined) */
+    float u_px[GS_FEET_HIST];  /* heights along up, NaN missing (slot 2 + k: k frames before the newest examined;
+                                * NaN for k at or past the frames held) */
     float rest_px;             /* current floor level, NaN unknown */
     float floor_px;            /* the level it last rested on long enough (armed), NaN none */
     uint32_t rest_for_us;      /* how long it has rested so far (0: not resting) */
@@ -50,9 +51,9 @@ typedef struct {
 
 typedef struct {
     uint32_t t_us[GS_FEET_HIST];/* frame times of the history slots, microseconds modulo 2^32 */
-    uint32_t n;                 /* frames examined */
+    uint32_t n;                 /* frames examined, counted up to the GS_FEET_HIST - 2 held */
     uint8_t pending;            /* the newest frame waits for the next (outlier test) */
-    int64_t pend_t_us;          /* its time */
+    int64_t pend_t_us;          /* its time (once examined, t_last_us; GS_T_NONE before a frame) */
     float pend_size_px;         /* its body size */
     int64_t t_last_us, t_prev_us; /* the newest frame's time and the one before, whole */
     int64_t unseen_us;          /* the latest frame with a point missing, GS_T_NONE none */

@@ -58,20 +58,19 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
     ft->up_y = -1.0f;
     ft->delta_rel = delta_rel;
     ft->stop_touch = !RECROSS || (STOPS && stop_touch);
-    ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
+    ft->pend_t_us = ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         reset_track(&ft->pt[p]);
         for (int k = 0; k < GS_FEET_LOG; k++) ft->pt[p].lift[k].t_us = ft->pt[p].touch[k].t_us = GS_T_NONE;
     }
 }
 
-/* the newest event first; from_px only for touches */
-static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float from_px)
+/* the newest event first (a lift's from_px is not read: only a touch's is set) */
+static void log_event(gs_feet_event *ev, int64_t t_us, float level_px)
 {
     memmove(ev + 1, ev, (GS_FEET_LOG - 1) * sizeof *ev);
     ev->t_us = t_us;
     ev->level_px = level_px;
-    ev->from_px = from_px;
 }
 
 /* slot of the frame `back` frames before the newest (0: the newest): the history moves
@@ -79,7 +78,8 @@ static void log_event(gs_feet_event *ev, int64_t t_us, float level_px, float fro
 static unsigned slot(uint32_t back) { return back + WAIT_SLOTS; }
 
 /* frames held in the history (two slots are the pending frame and the one after it) */
-static NOINLINE uint32_t held(const gs_feet *ft) { return ft->n < GS_FEET_HIST - WAIT_SLOTS ? ft->n : GS_FEET_HIST - WAIT_SLOTS; }
+#define HELD_MAX (GS_FEET_HIST - WAIT_SLOTS)
+static uint32_t held(const gs_feet *ft) { return ft->n; }
 
 /* microseconds from the frame `back` frames before the newest to the newest (modulo 2^32: exact) */
 static ALWAYS_INLINE uint32_t age_us(const gs_feet *ft, uint32_t back) { return ft->t_us[slot(0)] - ft->t_us[slot(back)]; }
@@ -180,10 +180,10 @@ static bool landing_us(const gs_feet *ft, const gs_foot *f, float L, float margi
 
 /* the median of the point's heights `back`, `back`+1 and `back`+2 frames before the newest
  * (a lone outlier does not move it); the height `back` alone when those are not all known */
-static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
+static float med3_at(const gs_foot *f, uint32_t back)
 {
     float a = u_at(f, back);
-    if (back + 3u > held(ft)) return a;
+    if (back + 3u > HELD_MAX) return a;  /* (within the history; past the held frames heights are NaN) */
     float b = u_at(f, back + 1u), c = u_at(f, back + 2u);
     if (!fin(a) || !fin(b) || !fin(c)) return a;
     return gs_med3_f(a, b, c);
@@ -191,21 +191,21 @@ static float med3_at(const gs_feet *ft, const gs_foot *f, uint32_t back)
 
 /* still: the (median) height u_now moved less than STILL_REL x size per second against the
  * median about LAG_US back (the oldest held when the history is shorter): a detector's lone
- * jittery frame, there or here, is no motion */
-static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_px)
+ * jittery frame, there or here, is no motion, nor is the point's own jitter (jitter_px) */
+static bool still(const gs_feet *ft, const gs_foot *f, float u_now, float size_px, float jitter_px)
 {
     uint32_t n = held(ft), b = 1;
     if (n < 2) return false;
     while (b + 1 < n && age_us(ft, b) < LAG_US) b++;
-    float du = u_now - med3_at(ft, f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
-    if (NOISE_K * f->noise_px > lim) lim = NOISE_K * f->noise_px;  /* (jitter is no motion) */
+    float du = u_now - med3_at(f, b), lim = STILL_REL * size_px * (float)age_us(ft, b) * 1e-6f;
+    if (jitter_px > lim) lim = jitter_px;  /* (jitter is no motion) */
     return fabsf(du) < lim;  /* false for NaN (fabsf: a mask, no branch) */
 }
 
 /* speed over the interval ending `back` frames before the newest, px/s (NaN unknown) */
 static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
 {
-    if (back + 2 > held(ft)) return NAN;
+    /* (NaN unless both frames are held: the slots past the held frames are NaN; back <= 2) */
     uint32_t dt = age_us(ft, back + 1) - age_us(ft, back);
     return (u_at(f, back) - u_at(f, back + 1)) / ((float)dt * 1e-6f);
 }
@@ -218,8 +218,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (!fin(u)) return;  /* a missing frame changes nothing */
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);  /* (nothing below changes the history) */
     /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */
-    float margin = MARGIN_REL * size_px;
-    if (NOISE_K * f->noise_px > margin) margin = NOISE_K * f->noise_px;
+    float margin = MARGIN_REL * size_px, jitter = NOISE_K * f->noise_px;
+    if (jitter > margin) margin = jitter;
     if (u < f->low_px) f->low_px = u;  /* (NaN before a lift: no change) */
     /* a floor holds the point: the frame after a stop stays at its level; after a recrossing
      * (ankles) the heel comes down onto that level, not past it */
@@ -227,7 +227,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
         if (u < f->touch[0].level_px - (RECROSS ? (float)f->touch_unsure * margin : margin)) {
             memmove(f->touch, f->touch + 1, (GS_FEET_LOG - 1) * sizeof f->touch[0]);  /* it fell on */
             f->touch[GS_FEET_LOG - 1].t_us = GS_T_NONE;
-            f->lifted = RECROSS && f->touch_unsure == 2;  /* (a recrossing it fell past: still in the air) */
+            /* (a recrossing it fell past: still in the air; a stop's touch cleared lifted) */
+            if (RECROSS) f->lifted = f->touch_unsure == 2;
             f->touch_unsure = 0;
         } else if (!RECROSS || f->touch_unsure == 1 || !(v2 < 0.0f)) {
             f->touch_unsure = 0;
@@ -237,10 +238,10 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
      * (one is an outlier) */
     float lift_px = f->rest_px + d;  /* the lift level */
     bool above = u > lift_px + margin;
-    if (f->armed && above && f->lift_pending) {
+    if (above && f->lift_pending) {  /* (lift_pending only while armed) */
         int64_t tc;
         if (crossing_us(ft, f, lift_px, true, &tc)) {
-            log_event(f->lift, tc, f->rest_px, NAN);
+            log_event(f->lift, tc, f->rest_px);
             f->lifted = 1;
             f->low_px = u;
         }
@@ -253,11 +254,13 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (RECROSS) f->falling = v2 < -FALL_REL * size_px;  /* (read for recrossings only) */
     float vf = speed(ft, f, 2);  /* (the impact may fall inside the last falling interval) */
     if (!(vf < v1)) vf = v1;
-    if (vf < -FAST_REL * size_px && v2 > vf / STOP_RATIO && v2 > v1 / STOP_RATIO &&
+    /* (stopped against v1 is stopped against vf too: vf <= v1 once vf is a fall) */
+    if (vf < -FAST_REL * size_px && v2 > v1 / STOP_RATIO &&
         (stop_touch || !(u > f->floor_px - 2.0f * margin))) {
         int64_t tc;
         if (landing_us(ft, f, u + d, margin, size_px, &tc)) {
-            log_event(f->touch, tc, u, f->floor_px);
+            log_event(f->touch, tc, u);
+            f->touch[0].from_px = f->floor_px;
             f->touch_unsure = 1;
             f->lifted = 0;
         }
@@ -267,7 +270,8 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     if (RECROSS && !stop_touch && f->lifted && u <= back_px) {
         int64_t tc;
         if (crossing_us(ft, f, back_px, false, &tc)) {
-            log_event(f->touch, tc, f->floor_px, f->floor_px);
+            log_event(f->touch, tc, f->floor_px);
+            f->touch[0].from_px = f->floor_px;
             f->touch_unsure = 2;
             f->falling = 0;  /* the next frame tells */
         }
@@ -276,15 +280,16 @@ static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float siz
     /* the floor level: what the point rests on at its lowest (median heights: an outlier is
      * no step). A rest below it is a new floor, one far above it too (stepping up); a slow
      * rise in between (a heel or a toe rolling up before take-off) is leaving it */
-    float m = med3_at(ft, f, 0);
-    bool st = still(ft, f, m, size_px);
-    if (st && held(ft) >= 3) {  /* |second difference| of a still point: 1.954 sigma on average */
+    float m = med3_at(f, 0);
+    bool st = still(ft, f, m, size_px, jitter);  /* (noise_px is learnt below) */
+    if (st) {  /* |second difference| of a still point: 1.954 sigma on average (NaN: fewer than 3 held) */
         float d2 = fabsf(u - 2.0f * u_at(f, 1) + u_at(f, 2)) / 1.954f;
         if (f->noise_px > 0.0f && d2 > 3.0f * f->noise_px) d2 = 3.0f * f->noise_px;  /* (an outlier) */
         if (d2 == d2) f->noise_px += (f->noise_px > 0.0f ? 0.1f : 1.0f) * (d2 - f->noise_px);
     }
     bool resting = st && m <= f->rest_px + margin;  /* still throughout, at its level */
-    if (st && (!fin(f->rest_px) || m < f->rest_px - 2.0f * margin || m > f->rest_px + 3.0f * d + margin)) {
+    /* (outside the band around the floor, or no floor: NaN compares false) */
+    if (st && !(m >= f->rest_px - 2.0f * margin && m <= f->rest_px + 3.0f * d + margin)) {
         f->rest_px = m;  /* a new floor */
         f->rest_n = 0;
         resting = true;
@@ -316,22 +321,23 @@ static void process_pending(gs_feet *ft, const float *next)
 {
     unsigned s = WAIT_SLOTS - 1u;  /* the pending frame's */
     float size = ft->pend_size_px, spike = SPIKE_REL * size;
-    for (int p = 0; next && ft->n > 0 && p < GS_FEET_POINTS; p++) {
-        float a = u_at(&ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
-        float da = b - a, dc = b - c;  /* (a - b is -(b - a) exactly) */
-        if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
-    }
-    ft->n++;
-    /* the history one slot older */
+    if (next && ft->n > 0)
+        for (int p = 0; p < GS_FEET_POINTS; p++) {
+            float a = u_at(&ft->pt[p], 0), b = ft->pt[p].u_px[s], c = next[p];
+            float da = b - a, dc = b - c;  /* (a - b is -(b - a) exactly) */
+            if ((da > spike && dc > spike) || (da < -spike && dc < -spike)) ft->pt[p].u_px[s] = NAN;
+        }
+    if (ft->n < HELD_MAX) ft->n++;
+    /* the history one slot older (each point's just before its step, which reads only its own) */
     for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->t_us[k] = ft->t_us[k - 1u];
-    for (int p = 0; p < GS_FEET_POINTS; p++)
-        for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) ft->pt[p].u_px[k] = ft->pt[p].u_px[k - 1u];
     ft->t_prev_us = ft->t_last_us;
     ft->t_last_us = ft->pend_t_us;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
-        float u = u_at(&ft->pt[p], 0);  /* the pending frame, now the newest */
+        gs_foot *f = &ft->pt[p];
+        for (unsigned k = GS_FEET_HIST - 1u; k > 0u; k--) f->u_px[k] = f->u_px[k - 1u];
+        float u = u_at(f, 0);  /* the pending frame, now the newest */
         if (!fin(u)) ft->unseen_us = ft->t_last_us;
-        point_step(ft, &ft->pt[p], ft->t_last_us, u, size);
+        point_step(ft, f, ft->t_last_us, u, size);
     }
     ft->pending = 0;
 }
@@ -345,8 +351,8 @@ void gs_feet_push(gs_feet *ft, int64_t t_us, const float x_px[GS_FEET_POINTS],
                   const float y_px[GS_FEET_POINTS], gs_real up_x, gs_real up_y, gs_real size_px)
 {
     if (!(size_px > 0) || !(size_px < INFINITY) || t_us == GS_T_NONE) return;
-    int64_t last = ft->pending ? ft->pend_t_us : ft->t_last_us;
-    if (t_us <= last) return;  /* (last GS_T_NONE, the lowest int64: t_us, not GS_T_NONE, passes) */
+    /* (pend_t_us: the newest frame pushed, pending or examined; GS_T_NONE, the lowest int64, before one) */
+    if (t_us <= ft->pend_t_us) return;
     float ux = (float)up_x, uy = (float)up_y;
     if (!(ux * ft->up_x + uy * ft->up_y >= UP_COS_MIN)) {
         /* heights along another direction: the levels go, the logged events stay */
