@@ -520,30 +520,58 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
     return n;
 }
 
-/* |value| = mant * 2^e2 * 10^-p10 with `decimals` decimals, rounded half away from
+/* |value| = n * 10^-p (n consumed) with `decimals` decimals, rounded half away from
  * zero, a minus sign when neg and the rounded value is not 0; "" unless 0 <= decimals <= 9 */
-static size_t fmt_dec(char *buf, size_t cap, uint64_t mant, int e2, int p10, bool neg, int decimals)
+static size_t fmt_fixed_n(char *buf, size_t cap, gs_big *n, int p, bool neg, int decimals)
 {
     if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
-    char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
-    int nr = 0;
-    gs_dec d; /* mant 0: no digits, so every place written is a 0 */
-    dec_expand(mant, e2, p10, &d);
-    int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
-    if (count >= 0) nr = count + dec_round(&d, count, dig);
+    /* right to left: the place of n's last digit is decimals - p; below 0 dropped (the
+     * last one dropped rounds), above 0 zeros before it; at least one before the point */
+    int first = decimals - p;
+    uint32_t up = 0;
+    bool nonzero = false;
     char t[48];
-    size_t n = put_digits(t, nr && neg, dig, nr, nr - decimals, decimals);
-    return put_out(buf, cap, t, n);
+    char *s = t + sizeof t;
+    for (int i = first < 0 ? first : 0; i <= decimals || n->n || up; i++) {
+        uint32_t dg = i < first ? 0u : big_divmod_small(n, 10u);
+        if (i < 0) {
+            up = dg >= 5u;
+            continue;
+        }
+        if (i == decimals && i) *--s = '.';
+        dg += up;
+        up = dg == 10u;
+        if (up) dg = 0;
+        nonzero |= dg != 0;
+        *--s = (char)('0' + dg);
+    }
+    if (neg && nonzero) *--s = '-';
+    return put_out(buf, cap, s, (size_t)(t + sizeof t - s));
+}
+
+/* a uint64_t worth n * 10^-p, as fmt_fixed_n */
+static size_t fmt_fixed_u64(char *buf, size_t cap, uint64_t n, int p, bool neg, int decimals)
+{
+    gs_big b;
+    big_set(&b, n);
+    return fmt_fixed_n(buf, cap, &b, p, neg, decimals);
 }
 
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag >= gs_dbits(1e15)) return put_out(buf, cap, "", FMT_FAIL);
+    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     int e2;
     uint64_t mant = dbits_mant(mag, &e2);
-    return fmt_dec(buf, cap, mant, e2, 0, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+    /* As gs_num_fmt_fixed_f: the rounding reads the digits down to 10^-(decimals + 1),
+     * those of floor(|v| 10^(decimals + 1)) = mant 10^(decimals + 1) >> -e2 (< 10^25:
+     * 3 words). |v| < 1e15 < 2^50 with mant >= 2^52 (or 0): e2 < 0. */
+    gs_big n;
+    big_set(&n, mant);
+    for (int k = 0; k <= decimals; k++) (void)big_mul_add(&n, 10u, 0);
+    for (; e2 < 0 && n.n; e2++) big_shr1(&n);
+    return fmt_fixed_n(buf, cap, &n, decimals + 1, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
 }
 
 size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
@@ -565,23 +593,23 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
      * integer with decimals + 1 decimals; above, |v| = mant << e2 < 2^50 is an integer.
      * 64-bit integers, bit by bit: no big integer, no variable 64-bit shift. */
     uint64_t n = mant;
-    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_dec refuses */
+    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_fixed_n refuses */
     for (int k = 0; k < p; k++) n *= 10u;
     for (; e2 > 0; e2--) n <<= 1;
     for (; e2 < 0 && n; e2++) n >>= 1;
-    return fmt_dec(buf, cap, n, 0, p, (bits >> 31) != 0u, decimals);
+    return fmt_fixed_u64(buf, cap, n, p, (bits >> 31) != 0u, decimals);
 }
 
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
 {
     if (t_us == INT64_MIN) return put_out(buf, cap, "", FMT_FAIL);
     uint64_t mag = t_us < 0 ? (uint64_t)-t_us : (uint64_t)t_us;
-    return fmt_dec(buf, cap, mag, 0, 6, t_us < 0, decimals);
+    return fmt_fixed_u64(buf, cap, mag, 6, t_us < 0, decimals);
 }
 
 size_t gs_num_fmt_u32(char *buf, size_t cap, uint32_t v)
 {
-    return fmt_dec(buf, cap, v, 0, 0, false, 0);
+    return fmt_fixed_u64(buf, cap, v, 0, false, 0);
 }
 
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
