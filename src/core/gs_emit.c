@@ -290,13 +290,12 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
         w_raw(&w, ",", 1);
         w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
     }
-    if (w.ok) {
-        unsigned char x = 0;
-        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
-        char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
-        /* within NMEA_MAX: the widths of k_nmea_fields bound every field (their sums above) */
-        w_raw(&w, tail, sizeof tail);
-    }
+    /* the checksum of a line that failed is not written: w_raw adds nothing once !w.ok */
+    unsigned char x = 0;
+    for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
+    char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
+    /* within NMEA_MAX: the widths of k_nmea_fields bound every field (their sums above) */
+    w_raw(&w, tail, sizeof tail);
     return w_finish(&w);
 }
 
