@@ -432,8 +432,8 @@ bool gs_num_parse_int(const char *s, size_t len, long *out)
 /* ------------------------------------------------------------------ format */
 
 /* The leading decimal digits of a finite a > 0, exact: a = D * 10^-p with D an
- * integer of nd digits, of which the first DEC_KEEP are kept (enough for 15
- * integer digits, 9 decimals and the rounding digit). */
+ * integer of nd digits, of which at least the first DEC_KEEP - 3 are kept (enough
+ * for gs_num_fmt_sig's 15 digits and the rounding digit). */
 #define DEC_KEEP 32 /* a power of two: the digits are a ring */
 typedef struct {
     char ring[DEC_KEEP]; /* digit j of D counted from the least significant at ring[j % DEC_KEEP] */
@@ -441,18 +441,34 @@ typedef struct {
     int p;
 } gs_dec;
 
-/* the decimal digits of a = mant * 2^e2 * 10^-p10 (mant > 0) into d */
-static void dec_expand(uint64_t mant, int e2, int p10, gs_dec *d)
+/* n = mant * 2^e2 * 10^p, an integer: (mant * 5^-e2) * 10^e2 with p = -e2 when e2 < 0;
+ * returns p. 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words. */
+static int big_exact(gs_big *n, uint64_t mant, int e2)
+{
+    big_set(n, mant);
+    uint32_t base = e2 < 0 ? 5u : 2u;
+    for (int k = e2 < 0 ? -e2 : e2; k > 0;) {
+        /* a pass over n multiplies by as many factors as 32 bits hold (5^13, 2^30) */
+        uint32_t m = 1;
+        for (; k > 0 && m <= UINT32_MAX / 5u; k--) m *= base;
+        (void)big_mul_add(n, m, 0);
+    }
+    return e2 < 0 ? -e2 : 0;
+}
+
+/* the decimal digits of a = mant * 2^e2 (mant > 0) into d */
+static void dec_expand(uint64_t mant, int e2, gs_dec *d)
 {
     gs_big n;
-    big_set(&n, mant);
-    /* mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
-    for (int k = e2 < 0 ? -e2 : e2; k > 0; k--) (void)big_mul_add(&n, e2 < 0 ? 5u : 2u, 0);
-    d->p = p10 + (e2 < 0 ? -e2 : 0);
-    /* a digit per pass over n, least significant first; the divisions are 32-bit: no
-     * 64-bit division routine linked */
+    d->p = big_exact(&n, mant, e2);
+    /* 4 digits a pass over n, least significant first; 10^4 <= 2^16: the divisions are
+     * 32-bit, no 64-bit division routine linked */
     d->nd = 0;
-    while (n.n) d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)big_divmod_small(&n, 10u);
+    do /* a > 0: at least one pass */
+        for (uint32_t r = big_divmod_small(&n, 10000u), j = 0; j < 4; j++, r /= 10u)
+            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
+    while (n.n);
+    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top pass's leading zeros (a > 0) */
 }
 
 /* the magnitude bits of a double (finite) as mant * 2^e2 (no frexp/ldexp, no double arithmetic) */
@@ -561,17 +577,12 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
+    if (mag >= gs_dbits(1e15)) return put_out(buf, cap, "", FMT_FAIL);
     int e2;
     uint64_t mant = dbits_mant(mag, &e2);
-    /* As gs_num_fmt_fixed_f: the rounding reads the digits down to 10^-(decimals + 1),
-     * those of floor(|v| 10^(decimals + 1)) = mant 10^(decimals + 1) >> -e2 (< 10^25:
-     * 3 words). |v| < 1e15 < 2^50 with mant >= 2^52 (or 0): e2 < 0. */
     gs_big n;
-    big_set(&n, mant);
-    for (int k = 0; k <= decimals; k++) (void)big_mul_add(&n, 10u, 0);
-    for (; e2 < 0 && n.n; e2++) big_shr1(&n);
-    return fmt_fixed_n(buf, cap, &n, decimals + 1, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+    int p = big_exact(&n, mant, e2);
+    return fmt_fixed_n(buf, cap, &n, p, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
 }
 
 size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
@@ -620,7 +631,7 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     gs_dec d;
     int e2;
     uint64_t mant = dbits_mant(mag, &e2);
-    dec_expand(mant, e2, 0, &d);
+    dec_expand(mant, e2, &d);
     char dig[DEC_KEEP];
     int k = d.nd - d.p - 1; /* decimal exponent of the first digit */
     k += dec_round(&d, sig, dig); /* a carry: 1 and zeros, cut to sig digits below */
