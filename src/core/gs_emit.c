@@ -101,17 +101,19 @@ enum {
     V_REASON,   /* JSON: a jump's reject reason, null when accepted */
     V_WARNINGS, /* JSON: uint32_t GS_WARN_* bits as an array of names */
     V_CI95,     /* JSON: the gs_reals mid, lo, hi from here as [lo,hi] or null */
-    V_FLAG,     /* NMEA: bool as the character a (true) or b (false) */
+    V_FLAG,     /* NMEA: bool as the letter pair k_nmea_flags[a] (true, false) */
     V_DIGIT,    /* NMEA: a gs_reject_reason as one character, 0-9 then A-Z */
     V_INITIAL,  /* NMEA: a string's first letter in upper case */
     V_HEX8,     /* NMEA: the low byte of a uint32_t in two hex digits */
-    V_TEXT      /* NMEA: a string of at most a characters, NULL: this build's version */
+    V_TEXT      /* NMEA: a string of at most NMEA_TEXT_MAX characters, NULL: this build's version */
 };
 
 typedef struct {
     uint8_t off; /* offsetof the field in the event's union member */
-    uint8_t kind, a, b;
+    uint8_t kind : 4, a : 4; /* what a means: the kinds above (digits and pairs are below 16) */
+    uint8_t b;
 } field;
+_Static_assert(sizeof(field) == 3, "a field is 3 bytes");
 
 _Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field.off is 8 bits");
 
@@ -177,6 +179,12 @@ static void n_text(gs_w *w, const char *s, size_t max_len)
 
 static const char k_hex_upper[] = "0123456789ABCDEF";
 
+/* the NMEA letters of a V_FLAG field: true, false */
+static const char k_nmea_flags[][2] = {{'A', 'R'}, {'E', 'S'}};
+
+/* the version field's width */
+#define NMEA_TEXT_MAX 20
+
 /* after its comma */
 static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
 {
@@ -190,7 +198,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
     case V_FLAG: {
         bool b;
         memcpy(&b, p, sizeof b);
-        c[n++] = (char)(b ? f->a : f->b);
+        c[n++] = k_nmea_flags[f->a][b ? 0 : 1];
         break;
     }
     case V_DIGIT: {
@@ -215,7 +223,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
     default: { /* V_TEXT */
         const char *s;
         memcpy(&s, p, sizeof s);
-        n_text(w, s ? s : k_version, f->a);
+        n_text(w, s ? s : k_version, NMEA_TEXT_MAX);
         break;
     }
     }
@@ -229,7 +237,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
  * = 82 - "$GSJMP" - 10 commas - "*HH\r\n"; $GSSES 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - 6 - 10 - 5. */
 static const field k_nmea_fields[] = {
 #define N_START 0
-    NF(gs_ev_start, version, V_TEXT, 20, 0),
+    NF(gs_ev_start, version, V_TEXT, 0, 0),
     NF(gs_ev_start, fps_source, V_FIXED, 3, 10),
 #define N_JUMP 2
     NF(gs_ev_jump, t_takeoff_us, V_TIME, 3, 10),
@@ -240,7 +248,7 @@ static const field k_nmea_fields[] = {
     NF(gs_ev_jump, jump_height_m, V_FIXED, 3, 5),
     NF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 2, 6),
     NF(gs_ev_jump, n_samples, V_U32, 0, 0),
-    NF(gs_ev_jump, accepted, V_FLAG, 'A', 'R'),
+    NF(gs_ev_jump, accepted, V_FLAG, 0, 0),
     NF(gs_ev_jump, reason, V_DIGIT, 0, 0),
 #define N_HEIGHT 12
     NF(gs_ev_height, height_m, V_FIXED, 4, 12),
@@ -251,7 +259,7 @@ static const field k_nmea_fields[] = {
     NF(gs_ev_height, n_rejected, V_U32, 0, 0),
 #define N_SESSION 17
     NF(gs_ev_session, session, V_U32, 0, 5),
-    NF(gs_ev_session, ended, V_FLAG, 'E', 'S'),
+    NF(gs_ev_session, ended, V_FLAG, 1, 0),
     NF(gs_ev_session, reason, V_INITIAL, 0, 0),
     NF(gs_ev_session, t_start_us, V_TIME, 3, 10),
     NF(gs_ev_session, t_end_us, V_TIME, 3, 10),
