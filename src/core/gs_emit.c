@@ -145,19 +145,19 @@ static size_t fmt_number(char *t, size_t cap, int kind, const void *p, int decim
     return gs_num_fmt_fixed(t, cap, real_at(p), decimals);
 }
 
-/* That number; false (nothing written) when it is unknown, not finite or beyond 1e15.
- * width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the text is
- * wider, false when it cannot fit. */
+/* That number in at most `width` characters, with fewer decimals when the text is
+ * wider (NMEA: keeps a sentence <= 82 chars); false (nothing written) when it is
+ * unknown, not finite or beyond 1e15 (at any number of decimals: fewer do not help,
+ * every such text is shorter than t) or cannot fit. */
 static bool w_number(gs_w *w, int kind, const void *p, int decimals, size_t width)
 {
     char t[40];
     for (int d = decimals; d >= 0; d--) {
         size_t n = fmt_number(t, sizeof t, kind, p, d);
-        if (n && (!width || n <= width)) {
+        if (n && n <= width) {
             w_raw(w, t, n);
             return true;
         }
-        if (!width) break;
     }
     return false;
 }
@@ -247,16 +247,16 @@ static const field k_nmea_fields[] = {
     NF(gs_ev_jump, height_m, V_FIXED, 3, 6),
     NF(gs_ev_jump, jump_height_m, V_FIXED, 3, 5),
     NF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 2, 6),
-    NF(gs_ev_jump, n_samples, V_U32, 0, 0),
+    NF(gs_ev_jump, n_samples, V_U32, 0, 10),
     NF(gs_ev_jump, accepted, V_FLAG, 0, 0),
     NF(gs_ev_jump, reason, V_DIGIT, 0, 0),
 #define N_HEIGHT 12
     NF(gs_ev_height, height_m, V_FIXED, 4, 12),
     NF(gs_ev_height, ci95_lo_m, V_FIXED, 4, 12),
     NF(gs_ev_height, ci95_hi_m, V_FIXED, 4, 12),
-    NF(gs_ev_height, n_jumps, V_U32, 0, 0),
+    NF(gs_ev_height, n_jumps, V_U32, 0, 10),
 #define N_HEIGHT_END 16 /* the summary adds n_rejected */
-    NF(gs_ev_height, n_rejected, V_U32, 0, 0),
+    NF(gs_ev_height, n_rejected, V_U32, 0, 10),
 #define N_SESSION 17
     NF(gs_ev_session, session, V_U32, 0, 5),
     NF(gs_ev_session, ended, V_FLAG, 1, 0),
@@ -366,7 +366,7 @@ static void w_warnings(gs_w *w, uint32_t bits)
 /* a number, or null */
 static void w_json_number(gs_w *w, int kind, const void *p, int decimals)
 {
-    if (!w_number(w, kind, p, decimals, 0)) w_lit(w, "null");
+    if (!w_number(w, kind, p, decimals, SIZE_MAX)) w_lit(w, "null");
 }
 
 /* [lo,hi], or null: an interval with an unknown end is no interval */
