@@ -445,6 +445,8 @@ typedef struct {
  * returns p. 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words. */
 static int big_exact(gs_big *n, uint64_t mant, int e2)
 {
+    /* fewer factors for the same value (a float's mantissa ends in 29 zero bits) */
+    for (; mant && !(mant & 1u); mant >>= 1) e2++;
     big_set(n, mant);
     uint32_t base = e2 < 0 ? 5u : 2u;
     for (int k = e2 < 0 ? -e2 : e2; k > 0;) {
@@ -582,6 +584,9 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
     uint64_t mant = dbits_mant(mag, &e2);
     gs_big n;
     int p = big_exact(&n, mant, e2);
+    /* 4 digits a pass while more than the rounding digit stays below 10^-decimals: it
+     * alone rounds (fmt_fixed_n takes it) */
+    for (; p > decimals + 4; p -= 4) (void)big_divmod_small(&n, 10000u);
     return fmt_fixed_n(buf, cap, &n, p, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
 }
 
