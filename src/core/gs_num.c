@@ -505,25 +505,6 @@ static int dec_round(const gs_dec *d, int n, char *out)
     return up;
 }
 
-/* "[-]I[.F]" into t from digits dig[0..n) (values 0..9) worth 0.d0d1.. * 10^pt:
- * the integer part ("0" when pt <= 0), then `frac` digits after a point (no
- * point when 0). Returns the length. */
-static size_t put_digits(char *t, bool neg, const char *dig, int n, int pt, int frac)
-{
-    size_t len = 0;
-    if (neg) t[len++] = '-';
-    int i = 0;
-    if (pt <= 0) {
-        t[len++] = '0';
-        i = pt;
-    }
-    for (; i < pt + frac; i++) {
-        if (i == pt) t[len++] = '.';
-        t[len++] = (char)('0' + (i >= 0 && i < n ? dig[i] : 0));
-    }
-    return len;
-}
-
 /* a length no buffer holds: put_out writes "" and returns 0 */
 #define FMT_FAIL SIZE_MAX
 
@@ -538,11 +519,10 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
     return n;
 }
 
-/* |value| = n * 10^-p (n consumed) with `decimals` decimals, rounded half away from
- * zero, a minus sign when neg and the rounded value is not 0; "" unless 0 <= decimals <= 9 */
+/* |value| = n * 10^-p (n consumed) with `decimals` >= 0 decimals, rounded half away
+ * from zero, a minus sign when neg and the rounded value is not 0 */
 static size_t fmt_fixed_n(char *buf, size_t cap, gs_big *n, int p, bool neg, int decimals)
 {
-    if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     /* right to left: the place of n's last digit is decimals - p; below 0 dropped (the
      * last one dropped rounds), above 0 zeros before it; at least one before the point */
     int first = decimals - p;
@@ -567,9 +547,10 @@ static size_t fmt_fixed_n(char *buf, size_t cap, gs_big *n, int p, bool neg, int
     return put_out(buf, cap, s, (size_t)(t + sizeof t - s));
 }
 
-/* a uint64_t worth n * 10^-p, as fmt_fixed_n */
+/* a uint64_t worth n * 10^-p, as fmt_fixed_n; "" unless 0 <= decimals <= 9 */
 static size_t fmt_fixed_u64(char *buf, size_t cap, uint64_t n, int p, bool neg, int decimals)
 {
+    if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     gs_big b;
     big_set(&b, n);
     return fmt_fixed_n(buf, cap, &b, p, neg, decimals);
@@ -579,7 +560,7 @@ size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag >= gs_dbits(1e15)) return put_out(buf, cap, "", FMT_FAIL);
+    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     int e2;
     uint64_t mant = dbits_mant(mag, &e2);
     gs_big n;
@@ -609,7 +590,7 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
      * integer with decimals + 1 decimals; above, |v| = mant << e2 < 2^50 is an integer.
      * 64-bit integers, bit by bit: no big integer, no variable 64-bit shift. */
     uint64_t n = mant;
-    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_fixed_n refuses */
+    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_fixed_u64 refuses */
     for (int k = 0; k < p; k++) n *= 10u;
     for (; e2 > 0; e2--) n <<= 1;
     for (; e2 < 0 && n; e2++) n >>= 1;
@@ -652,14 +633,20 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     int nk = sig;
     while (nk > 1 && dig[nk - 1] == 0) nk--;
     bool neg = gs_dbits(v) & GS_DBITS_SIGN;
-    char t[48];
-    if (k >= -4 && k <= 14) return put_out(buf, cap, t, put_digits(t, neg, dig, nk, k + 1, nk > k + 1 ? nk - k - 1 : 0));
-    size_t n = put_digits(t, neg, dig, nk, 1, nk - 1);
-    t[n++] = 'e';
-    t[n++] = k < 0 ? '-' : '+';
+    /* the nk digits as an integer D < 10^15: |v| ~ D * 10^(k + 1 - nk), no rounding left */
+    uint64_t D = 0;
+    for (int i = 0; i < nk; i++) D = D * 10u + (uint64_t)dig[i];
+    gs_big n;
+    big_set(&n, D);
+    int p = nk - 1 - k;
+    if (k >= -4 && k <= 14) return fmt_fixed_n(buf, cap, &n, p, neg, p > 0 ? p : 0);
+    char t[48]; /* d.ddd (at most 17 characters) and e+XXX */
+    size_t len = fmt_fixed_n(t, sizeof t, &n, nk - 1, neg, nk - 1);
+    t[len++] = 'e';
+    t[len++] = k < 0 ? '-' : '+';
     int ak = k < 0 ? -k : k;
-    if (ak >= 100) t[n++] = (char)('0' + ak / 100);
-    t[n++] = (char)('0' + (ak / 10) % 10);
-    t[n++] = (char)('0' + ak % 10);
-    return put_out(buf, cap, t, n);
+    if (ak >= 100) t[len++] = (char)('0' + ak / 100);
+    t[len++] = (char)('0' + (ak / 10) % 10);
+    t[len++] = (char)('0' + ak % 10);
+    return put_out(buf, cap, t, len);
 }
