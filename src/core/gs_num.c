@@ -593,7 +593,7 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
     int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_fixed_u64 refuses */
     for (int k = 0; k < p; k++) n *= 10u;
     for (; e2 > 0; e2--) n <<= 1;
-    for (; e2 < 0 && n; e2++) n >>= 1;
+    for (; e2 < 0; e2++) n >>= 1; /* at most 149 steps */
     return fmt_fixed_u64(buf, cap, n, p, (bits >> 31) != 0u, decimals);
 }
 
