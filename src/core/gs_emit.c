@@ -101,17 +101,19 @@ enum {
     V_REASON,   /* JSON: a jump's reject reason, null when accepted */
     V_WARNINGS, /* JSON: uint32_t GS_WARN_* bits as an array of names */
     V_CI95,     /* JSON: the gs_reals mid, lo, hi from here as [lo,hi] or null */
-    V_FLAG,     /* NMEA: bool as the character a (true) or b (false) */
+    V_FLAG,     /* NMEA: bool as the letter pair k_nmea_flags[a] (true, false) */
     V_DIGIT,    /* NMEA: a gs_reject_reason as one character, 0-9 then A-Z */
     V_INITIAL,  /* NMEA: a string's first letter in upper case */
     V_HEX8,     /* NMEA: the low byte of a uint32_t in two hex digits */
-    V_TEXT      /* NMEA: a string of at most a characters, NULL: this build's version */
+    V_TEXT      /* NMEA: a string of at most NMEA_TEXT_MAX characters, NULL: this build's version */
 };
 
 typedef struct {
     uint8_t off; /* offsetof the field in the event's union member */
-    uint8_t kind, a, b;
+    uint8_t kind : 4, a : 4; /* what a means: the kinds above (digits and pairs are below 16) */
+    uint8_t b;
 } field;
+_Static_assert(sizeof(field) == 3, "a field is 3 bytes");
 
 _Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field.off is 8 bits");
 
@@ -143,19 +145,19 @@ static size_t fmt_number(char *t, size_t cap, int kind, const void *p, int decim
     return gs_num_fmt_fixed(t, cap, real_at(p), decimals);
 }
 
-/* That number; false (nothing written) when it is unknown, not finite or beyond 1e15.
- * width > 0 (NMEA, keeps a sentence <= 82 chars): fewer decimals when the text is
- * wider, false when it cannot fit. */
+/* That number in at most `width` characters, with fewer decimals when the text is
+ * wider (NMEA: keeps a sentence <= 82 chars); false (nothing written) when it is
+ * unknown, not finite or beyond 1e15 (at any number of decimals: fewer do not help,
+ * every such text is shorter than t) or cannot fit. */
 static bool w_number(gs_w *w, int kind, const void *p, int decimals, size_t width)
 {
     char t[40];
     for (int d = decimals; d >= 0; d--) {
         size_t n = fmt_number(t, sizeof t, kind, p, d);
-        if (n && (!width || n <= width)) {
+        if (n && n <= width) {
             w_raw(w, t, n);
             return true;
         }
-        if (!width) break;
     }
     return false;
 }
@@ -177,6 +179,12 @@ static void n_text(gs_w *w, const char *s, size_t max_len)
 
 static const char k_hex_upper[] = "0123456789ABCDEF";
 
+/* the NMEA letters of a V_FLAG field: true, false */
+static const char k_nmea_flags[][2] = {{'A', 'R'}, {'E', 'S'}};
+
+/* the version field's width */
+#define NMEA_TEXT_MAX 20
+
 /* after its comma */
 static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
 {
@@ -190,7 +198,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
     case V_FLAG: {
         bool b;
         memcpy(&b, p, sizeof b);
-        c[n++] = (char)(b ? f->a : f->b);
+        c[n++] = k_nmea_flags[f->a][b ? 0 : 1];
         break;
     }
     case V_DIGIT: {
@@ -215,7 +223,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
     default: { /* V_TEXT */
         const char *s;
         memcpy(&s, p, sizeof s);
-        n_text(w, s ? s : k_version, f->a);
+        n_text(w, s ? s : k_version, NMEA_TEXT_MAX);
         break;
     }
     }
@@ -229,7 +237,7 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
  * = 82 - "$GSJMP" - 10 commas - "*HH\r\n"; $GSSES 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - 6 - 10 - 5. */
 static const field k_nmea_fields[] = {
 #define N_START 0
-    NF(gs_ev_start, version, V_TEXT, 20, 0),
+    NF(gs_ev_start, version, V_TEXT, 0, 0),
     NF(gs_ev_start, fps_source, V_FIXED, 3, 10),
 #define N_JUMP 2
     NF(gs_ev_jump, t_takeoff_us, V_TIME, 3, 10),
@@ -239,19 +247,19 @@ static const field k_nmea_fields[] = {
     NF(gs_ev_jump, height_m, V_FIXED, 3, 6),
     NF(gs_ev_jump, jump_height_m, V_FIXED, 3, 5),
     NF(gs_ev_jump, takeoff_velocity_m_s, V_FIXED, 2, 6),
-    NF(gs_ev_jump, n_samples, V_U32, 0, 0),
-    NF(gs_ev_jump, accepted, V_FLAG, 'A', 'R'),
+    NF(gs_ev_jump, n_samples, V_U32, 0, 10),
+    NF(gs_ev_jump, accepted, V_FLAG, 0, 0),
     NF(gs_ev_jump, reason, V_DIGIT, 0, 0),
 #define N_HEIGHT 12
     NF(gs_ev_height, height_m, V_FIXED, 4, 12),
     NF(gs_ev_height, ci95_lo_m, V_FIXED, 4, 12),
     NF(gs_ev_height, ci95_hi_m, V_FIXED, 4, 12),
-    NF(gs_ev_height, n_jumps, V_U32, 0, 0),
+    NF(gs_ev_height, n_jumps, V_U32, 0, 10),
 #define N_HEIGHT_END 16 /* the summary adds n_rejected */
-    NF(gs_ev_height, n_rejected, V_U32, 0, 0),
+    NF(gs_ev_height, n_rejected, V_U32, 0, 10),
 #define N_SESSION 17
     NF(gs_ev_session, session, V_U32, 0, 5),
-    NF(gs_ev_session, ended, V_FLAG, 'E', 'S'),
+    NF(gs_ev_session, ended, V_FLAG, 1, 0),
     NF(gs_ev_session, reason, V_INITIAL, 0, 0),
     NF(gs_ev_session, t_start_us, V_TIME, 3, 10),
     NF(gs_ev_session, t_end_us, V_TIME, 3, 10),
@@ -290,13 +298,12 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
         w_raw(&w, ",", 1);
         w_nmea_value(&w, &ev->u, &k_nmea_fields[i]);
     }
-    if (w.ok) {
-        unsigned char x = 0;
-        for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
-        char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
-        w_raw(&w, tail, sizeof tail);
-        if (w.len > NMEA_MAX) w.ok = false; /* cannot happen with the widths above */
-    }
+    /* the checksum of a line that failed is not written: w_raw adds nothing once !w.ok */
+    unsigned char x = 0;
+    for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
+    char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
+    /* within NMEA_MAX: the widths of k_nmea_fields bound every field (their sums above) */
+    w_raw(&w, tail, sizeof tail);
     return w_finish(&w);
 }
 
@@ -359,7 +366,7 @@ static void w_warnings(gs_w *w, uint32_t bits)
 /* a number, or null */
 static void w_json_number(gs_w *w, int kind, const void *p, int decimals)
 {
-    if (!w_number(w, kind, p, decimals, 0)) w_lit(w, "null");
+    if (!w_number(w, kind, p, decimals, SIZE_MAX)) w_lit(w, "null");
 }
 
 /* [lo,hi], or null: an interval with an unknown end is no interval */

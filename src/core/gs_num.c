@@ -432,8 +432,8 @@ bool gs_num_parse_int(const char *s, size_t len, long *out)
 /* ------------------------------------------------------------------ format */
 
 /* The leading decimal digits of a finite a > 0, exact: a = D * 10^-p with D an
- * integer of nd digits, of which the first DEC_KEEP are kept (enough for 15
- * integer digits, 9 decimals and the rounding digit). */
+ * integer of nd digits, of which at least the first DEC_KEEP - 3 are kept (enough
+ * for gs_num_fmt_sig's 15 digits and the rounding digit). */
 #define DEC_KEEP 32 /* a power of two: the digits are a ring */
 typedef struct {
     char ring[DEC_KEEP]; /* digit j of D counted from the least significant at ring[j % DEC_KEEP] */
@@ -441,18 +441,36 @@ typedef struct {
     int p;
 } gs_dec;
 
-/* the decimal digits of a = mant * 2^e2 * 10^-p10 (mant > 0) into d */
-static void dec_expand(uint64_t mant, int e2, int p10, gs_dec *d)
+/* n = mant * 2^e2 * 10^p, an integer: (mant * 5^-e2) * 10^e2 with p = -e2 when e2 < 0;
+ * returns p. 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words. */
+static int big_exact(gs_big *n, uint64_t mant, int e2)
+{
+    /* fewer factors for the same value (a float's mantissa ends in 29 zero bits) */
+    for (; mant && !(mant & 1u); mant >>= 1) e2++;
+    big_set(n, mant);
+    uint32_t base = e2 < 0 ? 5u : 2u;
+    for (int k = e2 < 0 ? -e2 : e2; k > 0;) {
+        /* a pass over n multiplies by as many factors as 32 bits hold (5^13, 2^30) */
+        uint32_t m = 1;
+        for (; k > 0 && m <= UINT32_MAX / 5u; k--) m *= base;
+        (void)big_mul_add(n, m, 0);
+    }
+    return e2 < 0 ? -e2 : 0;
+}
+
+/* the decimal digits of a = mant * 2^e2 (mant > 0) into d */
+static void dec_expand(uint64_t mant, int e2, gs_dec *d)
 {
     gs_big n;
-    big_set(&n, mant);
-    /* mant * 2^e2 = (mant * 5^-e2) * 10^e2; 2^53 * 5^1074 < 2^2560 and 2^1024 fit BIG_W words */
-    for (int k = e2 < 0 ? -e2 : e2; k > 0; k--) (void)big_mul_add(&n, e2 < 0 ? 5u : 2u, 0);
-    d->p = p10 + (e2 < 0 ? -e2 : 0);
-    /* a digit per pass over n, least significant first; the divisions are 32-bit: no
-     * 64-bit division routine linked */
+    d->p = big_exact(&n, mant, e2);
+    /* 4 digits a pass over n, least significant first; 10^4 <= 2^16: the divisions are
+     * 32-bit, no 64-bit division routine linked */
     d->nd = 0;
-    while (n.n) d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)big_divmod_small(&n, 10u);
+    do /* a > 0: at least one pass */
+        for (uint32_t r = big_divmod_small(&n, 10000u), j = 0; j < 4; j++, r /= 10u)
+            d->ring[d->nd++ & (DEC_KEEP - 1)] = (char)(r % 10u);
+    while (n.n);
+    while (d->ring[(d->nd - 1) & (DEC_KEEP - 1)] == 0) d->nd--; /* the top pass's leading zeros (a > 0) */
 }
 
 /* the magnitude bits of a double (finite) as mant * 2^e2 (no frexp/ldexp, no double arithmetic) */
@@ -487,25 +505,6 @@ static int dec_round(const gs_dec *d, int n, char *out)
     return up;
 }
 
-/* "[-]I[.F]" into t from digits dig[0..n) (values 0..9) worth 0.d0d1.. * 10^pt:
- * the integer part ("0" when pt <= 0), then `frac` digits after a point (no
- * point when 0). Returns the length. */
-static size_t put_digits(char *t, bool neg, const char *dig, int n, int pt, int frac)
-{
-    size_t len = 0;
-    if (neg) t[len++] = '-';
-    int i = 0;
-    if (pt <= 0) {
-        t[len++] = '0';
-        i = pt;
-    }
-    for (; i < pt + frac; i++) {
-        if (i == pt) t[len++] = '.';
-        t[len++] = (char)('0' + (i >= 0 && i < n ? dig[i] : 0));
-    }
-    return len;
-}
-
 /* a length no buffer holds: put_out writes "" and returns 0 */
 #define FMT_FAIL SIZE_MAX
 
@@ -520,30 +519,56 @@ static size_t put_out(char *buf, size_t cap, const char *t, size_t n)
     return n;
 }
 
-/* |value| = mant * 2^e2 * 10^-p10 with `decimals` decimals, rounded half away from
- * zero, a minus sign when neg and the rounded value is not 0; "" unless 0 <= decimals <= 9 */
-static size_t fmt_dec(char *buf, size_t cap, uint64_t mant, int e2, int p10, bool neg, int decimals)
+/* |value| = n * 10^-p (n consumed) with `decimals` >= 0 decimals, rounded half away
+ * from zero, a minus sign when neg and the rounded value is not 0 */
+static size_t fmt_fixed_n(char *buf, size_t cap, gs_big *n, int p, bool neg, int decimals)
+{
+    /* right to left: the place of n's last digit is decimals - p; below 0 dropped (the
+     * last one dropped rounds), above 0 zeros before it; at least one before the point */
+    int first = decimals - p;
+    uint32_t up = 0;
+    bool nonzero = false;
+    char t[48];
+    char *s = t + sizeof t;
+    for (int i = first < 0 ? first : 0; i <= decimals || n->n || up; i++) {
+        uint32_t dg = i < first ? 0u : big_divmod_small(n, 10u);
+        if (i < 0) {
+            up = dg >= 5u;
+            continue;
+        }
+        if (i == decimals && i) *--s = '.';
+        dg += up;
+        up = dg == 10u;
+        if (up) dg = 0;
+        nonzero |= dg != 0;
+        *--s = (char)('0' + dg);
+    }
+    if (neg && nonzero) *--s = '-';
+    return put_out(buf, cap, s, (size_t)(t + sizeof t - s));
+}
+
+/* a uint64_t worth n * 10^-p, as fmt_fixed_n; "" unless 0 <= decimals <= 9 */
+static size_t fmt_fixed_u64(char *buf, size_t cap, uint64_t n, int p, bool neg, int decimals)
 {
     if (decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
-    char dig[DEC_KEEP]; /* the integer round(|v| * 10^decimals), most significant first */
-    int nr = 0;
-    gs_dec d; /* mant 0: no digits, so every place written is a 0 */
-    dec_expand(mant, e2, p10, &d);
-    int count = d.nd - d.p + decimals; /* digits at or above 10^-decimals */
-    if (count >= 0) nr = count + dec_round(&d, count, dig);
-    char t[48];
-    size_t n = put_digits(t, nr && neg, dig, nr, nr - decimals, decimals);
-    return put_out(buf, cap, t, n);
+    gs_big b;
+    big_set(&b, n);
+    return fmt_fixed_n(buf, cap, &b, p, neg, decimals);
 }
 
 size_t gs_num_fmt_fixed(char *buf, size_t cap, double v, int decimals)
 {
     uint64_t mag = gs_dbits_abs(v);
     /* not finite or |v| >= 1e15: NaN and inf have the largest magnitude bits */
-    if (mag >= gs_dbits(1e15)) return put_out(buf, cap, "", FMT_FAIL);
+    if (mag >= gs_dbits(1e15) || decimals < 0 || decimals > 9) return put_out(buf, cap, "", FMT_FAIL);
     int e2;
     uint64_t mant = dbits_mant(mag, &e2);
-    return fmt_dec(buf, cap, mant, e2, 0, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
+    gs_big n;
+    int p = big_exact(&n, mant, e2);
+    /* 4 digits a pass while more than the rounding digit stays below 10^-decimals: it
+     * alone rounds (fmt_fixed_n takes it) */
+    for (; p > decimals + 4; p -= 4) (void)big_divmod_small(&n, 10000u);
+    return fmt_fixed_n(buf, cap, &n, p, (gs_dbits(v) & GS_DBITS_SIGN) != 0u, decimals);
 }
 
 size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
@@ -565,23 +590,23 @@ size_t gs_num_fmt_fixed_f(char *buf, size_t cap, float v, int decimals)
      * integer with decimals + 1 decimals; above, |v| = mant << e2 < 2^50 is an integer.
      * 64-bit integers, bit by bit: no big integer, no variable 64-bit shift. */
     uint64_t n = mant;
-    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_dec refuses */
+    int p = e2 < 0 && decimals >= 0 && decimals <= 9 ? decimals + 1 : 0; /* else fmt_fixed_u64 refuses */
     for (int k = 0; k < p; k++) n *= 10u;
     for (; e2 > 0; e2--) n <<= 1;
-    for (; e2 < 0 && n; e2++) n >>= 1;
-    return fmt_dec(buf, cap, n, 0, p, (bits >> 31) != 0u, decimals);
+    for (; e2 < 0; e2++) n >>= 1; /* at most 149 steps */
+    return fmt_fixed_u64(buf, cap, n, p, (bits >> 31) != 0u, decimals);
 }
 
 size_t gs_num_fmt_us(char *buf, size_t cap, int64_t t_us, int decimals)
 {
     if (t_us == INT64_MIN) return put_out(buf, cap, "", FMT_FAIL);
     uint64_t mag = t_us < 0 ? (uint64_t)-t_us : (uint64_t)t_us;
-    return fmt_dec(buf, cap, mag, 0, 6, t_us < 0, decimals);
+    return fmt_fixed_u64(buf, cap, mag, 6, t_us < 0, decimals);
 }
 
 size_t gs_num_fmt_u32(char *buf, size_t cap, uint32_t v)
 {
-    return fmt_dec(buf, cap, v, 0, 0, false, 0);
+    return fmt_fixed_u64(buf, cap, v, 0, false, 0);
 }
 
 size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
@@ -592,7 +617,7 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     gs_dec d;
     int e2;
     uint64_t mant = dbits_mant(mag, &e2);
-    dec_expand(mant, e2, 0, &d);
+    dec_expand(mant, e2, &d);
     char dig[DEC_KEEP];
     int k = d.nd - d.p - 1; /* decimal exponent of the first digit */
     k += dec_round(&d, sig, dig); /* a carry: 1 and zeros, cut to sig digits below */
@@ -608,14 +633,20 @@ size_t gs_num_fmt_sig(char *buf, size_t cap, double v, int sig)
     int nk = sig;
     while (nk > 1 && dig[nk - 1] == 0) nk--;
     bool neg = gs_dbits(v) & GS_DBITS_SIGN;
-    char t[48];
-    if (k >= -4 && k <= 14) return put_out(buf, cap, t, put_digits(t, neg, dig, nk, k + 1, nk > k + 1 ? nk - k - 1 : 0));
-    size_t n = put_digits(t, neg, dig, nk, 1, nk - 1);
-    t[n++] = 'e';
-    t[n++] = k < 0 ? '-' : '+';
+    /* the nk digits as an integer D < 10^15: |v| ~ D * 10^(k + 1 - nk), no rounding left */
+    uint64_t D = 0;
+    for (int i = 0; i < nk; i++) D = D * 10u + (uint64_t)dig[i];
+    gs_big n;
+    big_set(&n, D);
+    int p = nk - 1 - k;
+    if (k >= -4 && k <= 14) return fmt_fixed_n(buf, cap, &n, p, neg, p > 0 ? p : 0);
+    char t[48]; /* d.ddd (at most 17 characters) and e+XXX */
+    size_t len = fmt_fixed_n(t, sizeof t, &n, nk - 1, neg, nk - 1);
+    t[len++] = 'e';
+    t[len++] = k < 0 ? '-' : '+';
     int ak = k < 0 ? -k : k;
-    if (ak >= 100) t[n++] = (char)('0' + ak / 100);
-    t[n++] = (char)('0' + (ak / 10) % 10);
-    t[n++] = (char)('0' + ak % 10);
-    return put_out(buf, cap, t, n);
+    if (ak >= 100) t[len++] = (char)('0' + ak / 100);
+    t[len++] = (char)('0' + (ak / 10) % 10);
+    t[len++] = (char)('0' + ak % 10);
+    return put_out(buf, cap, t, len);
 }
