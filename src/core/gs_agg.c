@@ -106,10 +106,7 @@ void gs_agg_init(gs_agg *a)
     if (!a) {
         return;
     }
-    for (uint32_t i = 0; i < GS_AGG_MAX; i++) {
-        a->value[i] = NAN;
-        a->se[i] = NAN;
-    }
+    /* (value and se need no clearing: only the held slots, which gs_agg_add wrote, are read) */
     a->held = a->next = 0;
     a->n_accepted = a->n_rejected = 0;
 }
