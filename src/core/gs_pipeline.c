@@ -176,8 +176,10 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
     if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
      * left open must close on them first (as it would on any long gap); the
-     * difference as uint64 is exact for any two accepted times */
-    if (last_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
+     * difference as uint64 is exact for any two accepted times, and at least 2^62
+     * before the first frame (GS_T_NONE), where the break, as a flush would, finds
+     * neither a sample nor a flight */
+    if ((uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
         gs_flight_break(&p->flight);
     gs_ring_store(&p->ring, s);  /* (checked above as gs_ring_push would) */
     if (feet_xy) gs_flight_feet(&p->flight, s->t_us, feet_xy, feet_xy + GS_FEET_POINTS, s->size_px);
