@@ -117,13 +117,13 @@ void gs_agg_add(gs_agg *a, gs_real value_m, gs_real se_m)
         return;
     }
     /* A flight without a usable size (finite, > 0) was a flight that failed: count it as rejected. */
-    if (!(value_m > GS_R(0.0) && value_m < (gs_real)INFINITY)) {
+    if (!(value_m > GS_R(0.0) && gs_finite_r(value_m))) {
         a->n_rejected++;
         return;
     }
     a->value[a->next] = (float)value_m;
     /* finite and >= 0 (-0 included); an unknown SE is kept as NaN */
-    bool se_ok = se_m >= GS_R(0.0) && se_m < (gs_real)INFINITY;
+    bool se_ok = se_m >= GS_R(0.0) && gs_finite_r(se_m);
     a->se[a->next] = se_ok ? (float)se_m : NAN;
     a->next = (a->next + 1u) % GS_AGG_MAX;
     if (a->held < GS_AGG_MAX) {
