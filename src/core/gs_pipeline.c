@@ -160,7 +160,8 @@ static void track_session(gs_pipeline *p, const gs_sample_full *s)
         gs_session_close(&p->session);
         gs_agg_init(&p->agg);
         gs_flight_forget_body(&p->flight);
-        if (present) r = gs_session_frame(&p->session, s->t_us, present, (gs_real)NAN, &why);
+        /* the frame again, for the next visit: present, it starts one (absent, it does nothing) */
+        r = gs_session_frame(&p->session, s->t_us, present, (gs_real)NAN, &why);
     }
     if (r & GS_SESSION_STARTED) emit_session(p, false, NULL);
 }
