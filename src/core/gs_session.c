@@ -22,10 +22,12 @@ static void reset_visit(gs_session *s)
 void gs_session_init(gs_session *s, int64_t absence_us, gs_real new_body_rel)
 {
     if (!s) return;
-    memset(s, 0, sizeof *s);
+    /* each field before the visit's, which reset_visit sets */
     s->absence_us = absence_us;
     s->new_body_rel = new_body_rel;
     s->gap_us = absence_us < GAP_MAX_US ? absence_us : GAP_MAX_US;
+    s->id = 0;
+    s->open = false;
     s->t_start_us = s->t_seen_us = GS_T_NONE;
     reset_visit(s);
 }
