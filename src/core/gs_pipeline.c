@@ -88,7 +88,9 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     size_t need = gs_pipeline_storage_bytes(in);
     if (need == 0 || storage_bytes < need) return GS_ENOMEM;
     memset(p, 0, sizeof *p);
-    p->cfg = *cfg;
+#ifndef GS_BAKED_PROFILE
+    p->cfg = *cfg;  /* (read through GS_CFG_IN, which a baked build points at its own constant) */
+#endif
     p->layout = layout;
     p->on_event = on_event;
     p->ctx = ctx;
