@@ -155,7 +155,7 @@ static void emit_session(gs_pipeline *p, bool ended, const char *reason)
 static void track_session(gs_pipeline *p, const gs_sample_full *s)
 {
     bool present = s->w >= 0.05f;  /* (a sample's w is 0 where its position is not finite) */
-    const char *why = NULL;
+    const char *why;  /* (set by gs_session_frame with every GS_SESSION_ENDED) */
     uint32_t r = gs_session_frame(&p->session, s->t_us, present, gs_flight_stand_at(&p->flight, s->t_us), &why);
     if (r & GS_SESSION_ENDED) {
         emit_session(p, true, why);
