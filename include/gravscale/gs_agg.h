@@ -10,9 +10,9 @@
 #define GS_AGG_MAX 64
 
 typedef struct {
-    float value[GS_AGG_MAX];  /* per-flight size, metres */
+    float value[GS_AGG_MAX];  /* per-flight size, metres; slots [0, held) in use */
     float se[GS_AGG_MAX];     /* its standard error, metres */
-    uint32_t held, next;
+    uint32_t held, next;      /* slots in use (up to GS_AGG_MAX), the next one to write */
     uint32_t n_accepted, n_rejected;
 } gs_agg;
 

@@ -76,7 +76,8 @@ GS_RING_FN uint32_t gs_ring_count(const gs_ring *r)
 /* Packed sample at absolute index i, NULL when i is not held any more (or not yet). */
 GS_RING_FN const gs_sample *gs_ring_at(const gs_ring *r, uint64_t i)
 {
-    if (!r || !r->buf || i >= r->head || i < gs_ring_oldest(r)) {
+    /* (a ring gs_ring_init did not set up holds nothing: zeroed, head is 0) */
+    if (!r || i >= r->head || i < gs_ring_oldest(r)) {
         return NULL;
     }
     return &r->buf[(uint32_t)(i & r->mask)];

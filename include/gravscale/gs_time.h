@@ -42,9 +42,8 @@ static inline gs_real gs_time_span_us(int64_t t1_us, int64_t t0_us)
     int64_t d = t1_us - t0_us;  /* both within +-2^62: no overflow */
     if (GS_REAL_IS_FLOAT) {
         /* int32 -> float is one instruction; int64 -> float a libgcc call; spans
-         * saturate at +-INT32_MAX us */
-        if (d > INT32_MAX) d = INT32_MAX;
-        if (d < -INT32_MAX) d = -INT32_MAX;
+         * saturate at +-2^31 us (INT32_MIN and -INT32_MAX are both -2^31 as floats) */
+        if (d < INT32_MIN || d > INT32_MAX) d = d < 0 ? INT32_MIN : INT32_MAX;
         return (gs_real)(int32_t)d;
     }
     return (gs_real)d;

@@ -106,10 +106,7 @@ void gs_agg_init(gs_agg *a)
     if (!a) {
         return;
     }
-    for (uint32_t i = 0; i < GS_AGG_MAX; i++) {
-        a->value[i] = NAN;
-        a->se[i] = NAN;
-    }
+    /* (value and se need no clearing: only the held slots, which gs_agg_add wrote, are read) */
     a->held = a->next = 0;
     a->n_accepted = a->n_rejected = 0;
 }
@@ -120,13 +117,13 @@ void gs_agg_add(gs_agg *a, gs_real value_m, gs_real se_m)
         return;
     }
     /* A flight without a usable size (finite, > 0) was a flight that failed: count it as rejected. */
-    if (!(value_m > GS_R(0.0) && value_m < (gs_real)INFINITY)) {
+    if (!(value_m > GS_R(0.0) && gs_finite_r(value_m))) {
         a->n_rejected++;
         return;
     }
     a->value[a->next] = (float)value_m;
     /* finite and >= 0 (-0 included); an unknown SE is kept as NaN */
-    bool se_ok = se_m >= GS_R(0.0) && se_m < (gs_real)INFINITY;
+    bool se_ok = se_m >= GS_R(0.0) && gs_finite_r(se_m);
     a->se[a->next] = se_ok ? (float)se_m : NAN;
     a->next = (a->next + 1u) % GS_AGG_MAX;
     if (a->held < GS_AGG_MAX) {
@@ -155,12 +152,12 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
     }
     out->n_jumps = a->n_accepted;
     out->n_rejected = a->n_rejected;
-    uint32_t n = a->held > GS_AGG_MAX ? GS_AGG_MAX : a->held;
+    uint32_t n = a->held;  /* (at most GS_AGG_MAX: gs_agg_add counts up to it) */
     if (n == 0) {
         return;
     }
 
-    gs_real v[GS_AGG_MAX], dev[GS_AGG_MAX];
+    gs_real v[GS_AGG_MAX];
     gs_real se2_sum = GS_R(0.0);
     uint32_t n_se = 0;
     for (uint32_t i = 0; i < n; i++) {
@@ -183,10 +180,11 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
         /* Between-flight spread: MAD, scaled to a normal sigma, small-sample corrected. */
 #ifdef __OPTIMIZE_SIZE__
         for (uint32_t i = 0; i < n; i++) {
-            dev[i] = GS_FABSR(v[i] - med);
+            v[i] = GS_FABSR(v[i] - med);  /* in place: the sizes are not read again */
         }
-        gs_real mad = gs_sort_median(dev, n);
+        gs_real mad = gs_sort_median(v, n);
 #else
+        gs_real dev[GS_AGG_MAX];
         gs_real mad = median_abs_dev_sorted(v, n, med, dev);
 #endif
         gs_real corr = n < 10 ? k_mad_corr[n - 2u] : (gs_real)n / ((gs_real)n - GS_R(0.8));

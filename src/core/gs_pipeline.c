@@ -88,7 +88,9 @@ gs_status gs_pipeline_init(gs_pipeline *p, const gs_core_config *cfg, gs_layout 
     size_t need = gs_pipeline_storage_bytes(in);
     if (need == 0 || storage_bytes < need) return GS_ENOMEM;
     memset(p, 0, sizeof *p);
-    p->cfg = *cfg;
+#ifndef GS_BAKED_PROFILE
+    p->cfg = *cfg;  /* (read through GS_CFG_IN, which a baked build points at its own constant) */
+#endif
     p->layout = layout;
     p->on_event = on_event;
     p->ctx = ctx;
@@ -153,14 +155,15 @@ static void emit_session(gs_pipeline *p, bool ended, const char *reason)
 static void track_session(gs_pipeline *p, const gs_sample_full *s)
 {
     bool present = s->w >= 0.05f;  /* (a sample's w is 0 where its position is not finite) */
-    const char *why = NULL;
+    const char *why;  /* (set by gs_session_frame with every GS_SESSION_ENDED) */
     uint32_t r = gs_session_frame(&p->session, s->t_us, present, gs_flight_stand_at(&p->flight, s->t_us), &why);
     if (r & GS_SESSION_ENDED) {
         emit_session(p, true, why);
         gs_session_close(&p->session);
         gs_agg_init(&p->agg);
         gs_flight_forget_body(&p->flight);
-        if (present) r = gs_session_frame(&p->session, s->t_us, present, (gs_real)NAN, &why);
+        /* the frame again, for the next visit: present, it starts one (absent, it does nothing) */
+        r = gs_session_frame(&p->session, s->t_us, present, (gs_real)NAN, &why);
     }
     if (r & GS_SESSION_STARTED) emit_session(p, false, NULL);
 }
@@ -176,8 +179,10 @@ static gs_status push_sample(gs_pipeline *p, const gs_sample_full *s, const floa
     if (!gs_time_ok(s->t_us)) return GS_ERANGE;
     /* after a gap beyond the ring's time span its samples leave it: a flight
      * left open must close on them first (as it would on any long gap); the
-     * difference as uint64 is exact for any two accepted times */
-    if (last_us != GS_T_NONE && (uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
+     * difference as uint64 is exact for any two accepted times, and at least 2^62
+     * before the first frame (GS_T_NONE), where the break, as a flush would, finds
+     * neither a sample nor a flight */
+    if ((uint64_t)s->t_us - (uint64_t)last_us >= (uint64_t)GS_RING_SPAN_US)
         gs_flight_break(&p->flight);
     gs_ring_store(&p->ring, s);  /* (checked above as gs_ring_push would) */
     if (feet_xy) gs_flight_feet(&p->flight, s->t_us, feet_xy, feet_xy + GS_FEET_POINTS, s->size_px);

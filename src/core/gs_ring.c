@@ -105,24 +105,23 @@ gs_status gs_ring_push(gs_ring *r, const gs_sample_full *s)
 void gs_ring_store(gs_ring *r, const gs_sample_full *s)
 {
     int64_t t = s->t_us;
-    if (r->t_last_us != GS_T_NONE) {
-        /* t - newest as uint64: exact for any two accepted times (up to 2^63) */
-        if ((uint64_t)t - (uint64_t)r->t_last_us >= (uint64_t)GS_RING_SPAN_US) {
-            r->valid_from = r->head;  /* everything held is too old to tell apart after a wrap */
-        } else {
-            /* ages are exact below 2^32 us: drop the samples that reached the span */
-            uint32_t lo = (uint32_t)(uint64_t)t;
-            uint64_t oldest = r->valid_from;
-            while (oldest < r->head &&
-                   (uint32_t)(lo - r->buf[(uint32_t)(oldest & r->mask)].t_us) >= (uint32_t)GS_RING_SPAN_US) {
-                oldest++;
-            }
-            r->valid_from = oldest;
-        }
+    uint32_t head = (uint32_t)r->head;  /* (slots from the low 32 bits of the index) */
+    uint32_t held = (uint32_t)(r->head - r->valid_from);  /* at most the capacity */
+    /* t - newest as uint64: exact for any two accepted times (up to 2^63); at least 2^62
+     * before the first sample (GS_T_NONE, the lowest int64), when nothing is held */
+    if ((uint64_t)t - (uint64_t)r->t_last_us >= (uint64_t)GS_RING_SPAN_US) {
+        held = 0;  /* everything held is too old to tell apart after a wrap */
     }
-    /* a full ring overwrites its oldest sample: the capacity newest stay held */
-    if (r->head - r->valid_from >= r->capacity) r->valid_from = r->head - r->capacity + 1u;
-    gs_sample *d = &r->buf[(uint32_t)(r->head & r->mask)];
+    /* a full ring overwrites its oldest sample (the capacity newest stay held), and the
+     * samples that reached the span leave: ages are exact below 2^32 us (the newest is
+     * less than 2^31 us old), and never grow from one sample to the next */
+    uint32_t lo = (uint32_t)(uint64_t)t;
+    while (held > 0u && (held >= r->capacity ||
+                         (uint32_t)(lo - r->buf[(head - held) & r->mask].t_us) >= (uint32_t)GS_RING_SPAN_US)) {
+        held--;
+    }
+    r->valid_from = r->head - held;
+    gs_sample *d = &r->buf[head & r->mask];
     d->t_us = (uint32_t)(uint64_t)t;  /* modulo 2^32: read back relative to the newest */
     d->x_px = s->x_px;
     d->y_px = s->y_px;

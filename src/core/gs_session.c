@@ -22,10 +22,12 @@ static void reset_visit(gs_session *s)
 void gs_session_init(gs_session *s, int64_t absence_us, gs_real new_body_rel)
 {
     if (!s) return;
-    memset(s, 0, sizeof *s);
+    /* each field before the visit's, which reset_visit sets */
     s->absence_us = absence_us;
     s->new_body_rel = new_body_rel;
     s->gap_us = absence_us < GAP_MAX_US ? absence_us : GAP_MAX_US;
+    s->id = 0;
+    s->open = false;
     s->t_start_us = s->t_seen_us = GS_T_NONE;
     reset_visit(s);
 }
@@ -122,25 +124,31 @@ static NOINLINE gs_real mean_of(gs_real sum, uint32_t n)
 void gs_session_event(const gs_session *s, bool ended, const char *reason, const gs_ev_height *stature,
                       uint32_t track, gs_event *ev)
 {
-    memset(ev, 0, sizeof *ev);
+    memset(ev, 0, sizeof *ev);  /* (no reason while the session is open) */
     ev->type = GS_EV_SESSION;
     gs_ev_session *e = &ev->u.session;
     e->track = track;
     e->session = s->id;
     e->ended = ended;
-    e->reason = ended ? reason : NULL;
     e->t_start_us = s->t_start_us;
-    e->t_end_us = ended ? s->t_seen_us : GS_T_NONE;
-    e->stature_m = e->ci95_lo_m = e->ci95_hi_m = (gs_real)NAN;
-    e->best_jump_m = e->mean_jump_m = e->best_flight_s = e->mean_flight_s = e->mean_takeoff_velocity_m_s =
-        (gs_real)NAN;
     e->n_jumps = s->n_jumps;
     e->n_rejected = s->n_rejected;
-    if (!ended) return;
+    if (!ended) {
+        /* the results come with the end */
+        e->t_end_us = GS_T_NONE;
+        e->stature_m = e->ci95_lo_m = e->ci95_hi_m = (gs_real)NAN;
+        e->best_jump_m = e->mean_jump_m = e->best_flight_s = e->mean_flight_s = e->mean_takeoff_velocity_m_s =
+            (gs_real)NAN;
+        return;
+    }
+    e->reason = reason;
+    e->t_end_us = s->t_seen_us;
     if (stature) {
         e->stature_m = stature->height_m;
         e->ci95_lo_m = stature->ci95_lo_m;
         e->ci95_hi_m = stature->ci95_hi_m;
+    } else {
+        e->stature_m = e->ci95_lo_m = e->ci95_hi_m = (gs_real)NAN;
     }
     e->best_jump_m = s->best_jump_m;
     e->best_flight_s = s->best_flight_s;
