@@ -30,13 +30,6 @@
 #define LAND_G_REL  5.8f   /* gravity in statures per s^2 (9.81 m/s^2 over a 1.7 m body): a landing foot's fall */
 #define WAIT_SLOTS  2u    /* history slots 0 and 1: the frame after the pending one, and the pending one */
 
-/* the size build's outlining heuristics keep these two as calls, though inline they are smaller */
-#ifdef __OPTIMIZE_SIZE__
-#define ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define ALWAYS_INLINE inline
-#endif
-
 /* one copy: called for nearly every height read */
 static NOINLINE bool fin(float v) { return gs_finite_f(v); }
 

@@ -20,5 +20,12 @@ static inline bool gs_finite2_f(float x, float y) { return isfinite(x) && isfini
 #endif
 /* a gs_real's finiteness: the float test where gs_real is float */
 static inline bool gs_finite_r(gs_real x) { return sizeof(gs_real) < sizeof(double) ? gs_finite_f((float)x) : isfinite(x); }
+/* three gs_reals finite: where the build optimises for size one test, as gs_finite2_f
+ * ((x - x) + (y - y) + (z - z) is 0 exactly then, NaN otherwise) */
+#ifdef __OPTIMIZE_SIZE__
+static inline bool gs_finite3_r(gs_real x, gs_real y, gs_real z) { return (x - x) + (y - y) + (z - z) == GS_R(0.0); }
+#else
+static inline bool gs_finite3_r(gs_real x, gs_real y, gs_real z) { return gs_finite_r(x) && gs_finite_r(y) && gs_finite_r(z); }
+#endif
 
 #endif

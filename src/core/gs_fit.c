@@ -152,20 +152,9 @@ static void add_row(gs_fit *f, gs_real tau, gs_real x_px, gs_real y_px, gs_real 
     f->n++;
 }
 
-/* a, b and c all finite (where the build optimises for size one test, as gs_finite2_f:
- * (a - a) + (b - b) + (c - c) is 0 exactly then, NaN otherwise) */
-static bool finite3_r(gs_real a, gs_real b, gs_real c)
-{
-#ifdef __OPTIMIZE_SIZE__
-    return (a - a) + (b - b) + (c - c) == GS_R(0.0);
-#else
-    return gs_finite_r(a) && gs_finite_r(b) && gs_finite_r(c);
-#endif
-}
-
 void gs_fit_add(gs_fit *f, int64_t t_us, gs_real x_px, gs_real y_px, gs_real w)
 {
-    if (!f || !(w > GS_R(0.0)) || !finite3_r(w, x_px, y_px) || !gs_time_ok(t_us)) {
+    if (!f || !(w > GS_R(0.0)) || !gs_finite3_r(w, x_px, y_px) || !gs_time_ok(t_us)) {
         return;
     }
     add_row(f, fit_tau(t_us, f->t0_us, f->tscale_s * GS_R(1e6)), x_px, y_px, w);

@@ -116,7 +116,7 @@ static const gs_sample_full *at(const gs_flight *f, uint32_t i, gs_sample_full *
 /* The flight's times (_lus): int32 microseconds from f->tb_us (gs_flight.h). The local
  * time of an absolute one within their range: the low words alone give it exactly, and a
  * 32-bit core loads and subtracts only those. */
-static inline __attribute__((always_inline)) int32_t lt_of(const gs_flight *f, int64_t t_us)
+static ALWAYS_INLINE int32_t lt_of(const gs_flight *f, int64_t t_us)
 {
     return (int32_t)((uint32_t)(uint64_t)t_us - (uint32_t)(uint64_t)f->tb_us);
 }
@@ -155,7 +155,7 @@ static NOINLINE bool span_over(int32_t t1_lus, int32_t t0_lus, int32_t span_us)
 /* t1 - t0 for two times less than 2^31 us apart (two held ring samples; a time inside a
  * flight window and its fit's centre, the window's samples held with it): the low words
  * alone give it exactly, and a 32-bit core loads and subtracts only those. */
-static inline __attribute__((always_inline)) int32_t near_us(int64_t t1_us, int64_t t0_us)
+static ALWAYS_INLINE int32_t near_us(int64_t t1_us, int64_t t0_us)
 {
     return (int32_t)(uint32_t)((uint64_t)t1_us - (uint64_t)t0_us);
 }

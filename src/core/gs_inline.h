@@ -1,4 +1,5 @@
-/* gs_inline.h - NOINLINE for the core's small helpers called from several places. */
+/* gs_inline.h - NOINLINE for the core's small helpers called from several places, and
+ * ALWAYS_INLINE for the few that the size build would otherwise keep as calls. */
 #ifndef GS_INLINE_H
 #define GS_INLINE_H
 
@@ -8,6 +9,14 @@
 #define NOINLINE __attribute__((noinline))
 #else
 #define NOINLINE
+#endif
+
+/* the size build's outlining heuristics keep some tiny helpers as calls, though inline
+ * they are smaller; elsewhere the compiler inlines them anyway */
+#ifdef __OPTIMIZE_SIZE__
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define ALWAYS_INLINE inline
 #endif
 
 #endif
