@@ -17,7 +17,7 @@
 typedef void (*gs_jump_judge_fn)(void *ctx, gs_ev_jump *jump);
 
 typedef struct {
-    gs_core_config cfg;        /* the caller's copy; none in a baked build (GS_BAKED_PROFILE), which reads its own */
+    gs_core_config cfg;        /* the caller's copy; left zeroed in a baked build (GS_BAKED_PROFILE), which reads its own constant */
     gs_layout layout;
     gs_ring ring;
     gs_flight flight;

@@ -152,7 +152,8 @@ void gs_agg_get(const gs_agg *a, gs_ev_height *out)
     }
     out->n_jumps = a->n_accepted;
     out->n_rejected = a->n_rejected;
-    uint32_t n = a->held;  /* (at most GS_AGG_MAX: gs_agg_add counts up to it) */
+    /* (gs_agg_add counts up to GS_AGG_MAX; clamped still, so a damaged struct cannot overrun v) */
+    uint32_t n = a->held < GS_AGG_MAX ? a->held : GS_AGG_MAX;
     if (n == 0) {
         return;
     }

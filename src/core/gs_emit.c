@@ -10,8 +10,8 @@
 #include "gs_dbits.h"
 #include "gs_inline.h"
 
-/* NMEA 0183 caps a sentence at 82 characters including "$" and CR LF. */
-#define NMEA_MAX 82u
+/* NMEA 0183 caps a sentence at 82 characters including "$" and CR LF: the field widths
+ * of k_nmea_fields keep every sentence within it (test_emit writes each at full width). */
 
 /* the default version text of both start lines: one object of its own, so that a
  * build with one format does not keep the other format's literals, which the
@@ -114,6 +114,7 @@ typedef struct {
     uint8_t b;
 } field;
 _Static_assert(sizeof(field) == 3, "a field is 3 bytes");
+_Static_assert(V_TEXT < 16, "field.kind is 4 bits");
 
 _Static_assert(sizeof(gs_ev_jump) <= 256 && sizeof(gs_ev_session) <= 256, "field.off is 8 bits");
 
@@ -233,8 +234,10 @@ static NOINLINE void w_nmea_value(gs_w *w, const void *base, const field *f)
 #define NF(type, name, kind, a, b) {(uint8_t)offsetof(type, name), kind, a, b}
 
 /* every sentence's fields, each after a comma, event by event (docs/protocol.md).
- * Widths keep a sentence within 82 characters: $GSJMP 10+5+8+9+6+5+6+10+1+1 = 61
- * = 82 - "$GSJMP" - 10 commas - "*HH\r\n"; $GSSES 5+1+1+10+10+6+3+5+5+5 = 51 <= 82 - 6 - 10 - 5. */
+ * Widths keep a sentence within 82 characters ("$GS" + tag 6, a comma a field, "*HH\r\n" 5;
+ * a V_U32 without width at most 10 digits, V_TEXT 20, a flag, digit or initial 1, hex 2):
+ * STA 43, JMP 82 ($GSJMP 10+5+8+9+6+5+6+10+1+1 = 61 = 82 - 6 - 10 - 5), HGT 61, SUM 72,
+ * SES 72, WRN 25. */
 static const field k_nmea_fields[] = {
 #define N_START 0
     NF(gs_ev_start, version, V_TEXT, 0, 0),
@@ -302,7 +305,7 @@ size_t gs_emit_nmea(const gs_event *ev, char *buf, size_t cap)
     unsigned char x = 0;
     for (size_t i = 1; i < w.len; i++) x ^= (unsigned char)w.buf[i];
     char tail[5] = {'*', k_hex_upper[x >> 4], k_hex_upper[x & 15u], '\r', '\n'};
-    /* within NMEA_MAX: the widths of k_nmea_fields bound every field (their sums above) */
+    /* within 82 characters: the widths of k_nmea_fields bound every sentence (their sums there) */
     w_raw(&w, tail, sizeof tail);
     return w_finish(&w);
 }

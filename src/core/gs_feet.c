@@ -22,8 +22,9 @@
                              * (stepping onto a box takes long; a foot at its apex in the air is still briefly) */
 /* the touch by recrossing serves ankles (COCO-17) only: a build without that layout has none */
 #define RECROSS GS_WITH_COCO17  /* (touch_unsure is 2 after a recrossing only) */
-/* ... and the touch by the stop toes (BlazePose-33): a build with only one of the layouts has only its touch */
-#define STOPS (!RECROSS || GS_WITH_BLAZEPOSE33)
+/* ... and the touch by the stop toes (BlazePose-33): a build with only one of the layouts has
+ * only its touch, so the caller's choice (stop) is read only where both are built in */
+#define STOP_TOUCH(stop) (!RECROSS || (GS_WITH_BLAZEPOSE33 && (stop)))
 #define NOISE_K     3.0f   /* margins at least this many of the point's own jitter */
 #define SPIKE_REL   0.03f  /* a lone frame this far off both neighbours (x size) is an outlier */
 #define BRAKE_RATIO 2.0f   /* a falling point slowed more than this in a frame was stopped within it */
@@ -50,7 +51,7 @@ void gs_feet_init(gs_feet *ft, float delta_rel, bool stop_touch)
     memset(ft, 0, sizeof *ft);
     ft->up_y = -1.0f;
     ft->delta_rel = delta_rel;
-    ft->stop_touch = !RECROSS || (STOPS && stop_touch);
+    ft->stop_touch = STOP_TOUCH(stop_touch);
     ft->pend_t_us = ft->t_last_us = ft->t_prev_us = ft->unseen_us = GS_T_NONE;
     for (int p = 0; p < GS_FEET_POINTS; p++) {
         reset_track(&ft->pt[p]);
@@ -207,7 +208,7 @@ static float speed(const gs_feet *ft, const gs_foot *f, uint32_t back)
 static void point_step(gs_feet *ft, gs_foot *f, int64_t t_us, float u, float size_px)
 {
     float d = ft->delta_rel * size_px;
-    bool stop_touch = !RECROSS || (STOPS && ft->stop_touch);  /* (ft->stop_touch, folded where the build has one touch) */
+    bool stop_touch = STOP_TOUCH(ft->stop_touch);
     if (!fin(u)) return;  /* a missing frame changes nothing */
     float v1 = speed(ft, f, 1), v2 = speed(ft, f, 0);  /* (nothing below changes the history) */
     /* the point's own jitter, learnt while it is still: a detector's toes jitter more than its COM */

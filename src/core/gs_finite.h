@@ -1,4 +1,4 @@
-/* gs_finite.h - a float's finiteness (private to the core's files). */
+/* gs_finite.h - finiteness of floats and gs_reals, alone or several at once (private to the core's files). */
 #ifndef GS_FINITE_H
 #define GS_FINITE_H
 

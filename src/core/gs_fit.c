@@ -185,32 +185,38 @@ typedef struct {
     gs_real c[6];
 } gs_par;
 
+/* R can be solved: each diagonal entry nonzero and not negligible against its column's norm
+ * (the column norms of R equal those of the weighted design: Q is orthogonal) */
+static bool r_regular(const gs_fit *f)
+{
+    gs_real col[3];
+    const gs_real *rk = f->r; /* row k of R: its diagonal first */
+    col[0] = fabs(f->r[0]);
+    col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
+    col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
+    for (int k = 0; k < 3; rk += 3 - k, k++) {
+        /* (an infinite diagonal makes its column's norm infinite or NaN: refused too) */
+        gs_real d = fabs(*rk);
+        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k])) {
+            return false;
+        }
+    }
+    return true;
+}
+
 /* gs_fit_solve, and on success the tau-basis parabola to *p (when p is not NULL); with
  * base, f fitted the samples less base: base is added back. */
 static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const gs_par *base)
 {
     gs_par par;
-    gs_real *cx = &par.c[0], *cy = &par.c[3], col[3], ts, ts2, ssr;
-    const gs_real *rk; /* row k of R: its diagonal first (f checked first) */
+    gs_real *cx = &par.c[0], *cy = &par.c[3], ts, ts2, ssr;
     int k;
     if (!f || !out) {
         return GS_EINVAL;
     }
     empty_result(out, f->n, f->t0_us);
-    if (f->n < 3) {
+    if (f->n < 3 || !r_regular(f)) {
         return GS_EINVAL;
-    }
-    /* Column norms of R equal those of the weighted design (Q is orthogonal). */
-    col[0] = fabs(f->r[0]);
-    col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
-    col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
-    rk = f->r;
-    for (k = 0; k < 3; rk += 3 - k, k++) {
-        /* (an infinite diagonal makes its column's norm infinite or NaN: refused too) */
-        gs_real d = fabs(*rk);
-        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k])) {
-            return GS_EINVAL;
-        }
     }
     back_sub(f->r, f->zx, cx);
     back_sub(f->r, f->zy, cy);
@@ -253,20 +259,9 @@ static gs_status solve_par(const gs_fit *f, gs_fit_result *out, gs_par *p, const
  * the curve): the same checks and the same arithmetic */
 static gs_status solve_par_only(const gs_fit *f, gs_par *p, const gs_par *base)
 {
-    gs_real col[3];
-    const gs_real *rk = f->r;
     int k;
-    if (f->n < 3) {
+    if (f->n < 3 || !r_regular(f)) {
         return GS_EINVAL;
-    }
-    col[0] = fabs(f->r[0]);
-    col[1] = sqrt(f->r[1] * f->r[1] + f->r[3] * f->r[3]);
-    col[2] = sqrt(f->r[2] * f->r[2] + f->r[4] * f->r[4] + f->r[5] * f->r[5]);
-    for (k = 0; k < 3; rk += 3 - k, k++) {
-        gs_real d = fabs(*rk);
-        if (!(col[k] > GS_R(0.0)) || !(d > GS_FIT_SINGULAR_REL * col[k])) {
-            return GS_EINVAL;
-        }
     }
     back_sub(f->r, f->zx, &p->c[0]);
     back_sub(f->r, f->zy, &p->c[3]);
@@ -337,7 +332,7 @@ typedef struct {
     uint32_t *keep;           /* the caller's flags, a bit per sample (gs_fit_robust) */
     int64_t t0_us;            /* the window's centre */
     gs_real tscale_us_r;      /* its length in us (> 0, below the ring's 2^31 us span; exact below 2^24 us in float) */
-    gs_real tscale_s;         /* the same in seconds: its fits' scale (gs_time_span_s) */
+    gs_real tscale_s;         /* the same in seconds: its fits' scale (gs_time_span32_s) */
     gs_fsamp *cache;          /* samples [0, min(count, GS_FIT_CACHE)) */
     gs_real *r2;              /* their squared residuals from the last median_resid */
     gs_real *exy;             /* fast double builds: ... and their x and y residuals (2 rows of GS_FIT_CACHE) */
@@ -1645,7 +1640,8 @@ static gs_status fit_irls(const gs_win *wn, uint32_t m, gs_real floor_px, gs_fit
             saved = true;
         }
     }
-    /* (a run's loss is finite: each of at most count terms is at most its weight, <= 1) */
+    /* (no loss is NaN: a settled run's terms are each at most its weight, <= 1; a failed
+     * run's loss is INFINITY) */
     if (!(loss[PLAIN] <= loss[LMS])) {
         return GS_OK; /* the LMS run won */
     }

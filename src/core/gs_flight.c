@@ -365,7 +365,7 @@ gs_status gs_flight_init(gs_flight *f, const gs_core_config *cfg, const gs_ring 
     gs_flight_forget_body(f);       /* no standing size yet */
     f->last_a_px_s2 = NAN;
     f->last_g_dir_deg = NAN;
-    /* (f->feet is read only where gs_flight_use_feet set it up: FEET_ON) */
+    /* (f->feet is set up by gs_flight_use_feet, which a body's layout calls next: gs_flight.h) */
     f->last_land_us = GS_T_NONE;
     f->feet_wait_us = GS_T_NONE;
     return GS_OK;
@@ -660,7 +660,8 @@ static NOINLINE gs_status robust_fit(gs_flight *f, uint32_t first, uint32_t coun
                             float min_scale, gs_fit_result *r)
 {
 #if GS_CLOSE_LAG_FRAMES == 0
-    /* every close runs whole in one call (the firmware, whose code budget is full): it fits again */
+    /* no lag (the Cortex-M4 build): a close runs whole in one call, and a window it fits
+     * twice is fitted twice, the time paid for no memo in RAM or code */
     return gs_fit_robust(f->ring, ring_idx(f, first), count, method, min_scale, f->keep, r);
 #else
     gs_fit_memo *m = &f->memo;
